@@ -1,0 +1,10 @@
+# -DPLSLAM_SANITIZE=address|undefined|address,undefined|thread
+if(PLSLAM_SANITIZE)
+  set(_san_flags "-fsanitize=${PLSLAM_SANITIZE}" -fno-omit-frame-pointer)
+  if(PLSLAM_SANITIZE MATCHES "undefined")
+    list(APPEND _san_flags -fno-sanitize-recover=undefined)
+  endif()
+  add_compile_options(${_san_flags})
+  add_link_options(${_san_flags})
+  message(STATUS "plslam: sanitizers ${PLSLAM_SANITIZE}")
+endif()

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package plslam needs. Idempotent: packages that are
+# already present are skipped, and `apt-get update` runs at most once per call.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake pkg-config git
+  libopencv-dev libopencv-contrib-dev
+  libeigen3-dev libceres-dev libtbb-dev
+  libcli11-dev libspdlog-dev libfmt-dev libyaml-cpp-dev
+  nlohmann-json3-dev libcpp-httplib-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"

@@ -1,0 +1,5 @@
+#pragma once
+
+namespace plslam {
+inline constexpr const char* kVersion = PLSLAM_VERSION;
+}  // namespace plslam

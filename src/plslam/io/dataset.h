@@ -1,0 +1,68 @@
+#pragma once
+// Stereo datasets behind one interface. A Dataset knows its calibration (already rectified),
+// frame list and ground truth; images are decoded on demand, and FrameStream prefetches them
+// on a background thread with a bounded queue so memory does not grow with sequence length.
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "plslam/core/types.h"
+
+namespace plslam::io {
+
+enum class DatasetFormat { kAuto, kKitti, kEuroc };
+
+const char* to_string(DatasetFormat f);
+DatasetFormat parse_dataset_format(const std::string& name);  // auto|kitti|euroc
+
+struct StereoFrame {
+  std::size_t index = 0;  // index within the selected range
+  double timestamp = 0;   // seconds
+  cv::Mat left, right;    // 8-bit grey, rectified
+  std::filesystem::path left_path, right_path;
+};
+
+struct DatasetOptions {
+  DatasetFormat format = DatasetFormat::kAuto;
+  std::size_t start = 0;                       // first frame to use
+  std::optional<std::size_t> max_frames;       // at most this many frames
+};
+
+class Dataset {
+ public:
+  virtual ~Dataset() = default;
+
+  virtual DatasetFormat format() const = 0;
+  const std::filesystem::path& root() const { return root_; }
+  const StereoCalibration& calibration() const { return calib_; }
+  std::size_t size() const { return timestamps_.size(); }
+  const std::vector<double>& timestamps() const { return timestamps_; }
+  double fps() const;  // median frame rate; 0 with fewer than two frames
+
+  // Ground truth of the left camera (T_world_leftcam), restricted to the selected range where
+  // the format pairs it by index (KITTI), or the whole file's overlap in time (EuRoC).
+  const std::optional<Trajectory>& ground_truth() const { return gt_; }
+  const std::filesystem::path& ground_truth_path() const { return gt_path_; }
+
+  // Loads and rectifies frame i (0-based within the selected range). A missing or corrupt image
+  // throws InputError naming the file.
+  virtual StereoFrame load(std::size_t i) const = 0;
+
+ protected:
+  std::filesystem::path root_;
+  StereoCalibration calib_;
+  std::vector<double> timestamps_;
+  std::optional<Trajectory> gt_;
+  std::filesystem::path gt_path_;
+};
+
+// Opens a KITTI odometry sequence folder (sequences/NN) or an EuRoC/ASL sequence (<seq> or
+// <seq>/mav0). Throws InputError with the offending file and problem on bad input.
+std::unique_ptr<Dataset> open_dataset(const std::filesystem::path& path,
+                                      const DatasetOptions& options = {});
+
+}  // namespace plslam::io
