@@ -1,0 +1,27 @@
+#pragma once
+// The ASL/EuRoC camera sensor.yaml: intrinsics, radial-tangential distortion and T_BS, the pose
+// of the sensor in the body frame (p_body = T_BS * p_sensor).
+#include <array>
+#include <filesystem>
+
+#include <Eigen/Geometry>
+
+namespace plslam::io {
+
+struct EurocCameraSensor {
+  Eigen::Isometry3d T_BS = Eigen::Isometry3d::Identity();
+  int width = 0;
+  int height = 0;
+  double fu = 0, fv = 0, cu = 0, cv = 0;
+  std::array<double, 4> distortion{};  // k1, k2, p1, p2
+  double rate_hz = 0;
+};
+
+// Throws InputError naming the file on a missing file, malformed YAML, missing keys, wrong sizes,
+// NaNs or a T_BS that is not a rigid transform.
+EurocCameraSensor read_euroc_camera_yaml(const std::filesystem::path& path);
+
+// Reads only T_BS, for files such as a body-to-camera argument of `plslam eval`.
+Eigen::Isometry3d read_euroc_T_BS(const std::filesystem::path& path);
+
+}  // namespace plslam::io
