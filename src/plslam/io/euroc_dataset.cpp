@@ -169,14 +169,13 @@ class EurocDataset final : public Dataset {
   void load_ground_truth() {
     const auto path = root_ / "state_groundtruth_estimate0" / "data.csv";
     if (!fs::exists(path)) return;
-    const auto body = read_trajectory(path, TrajectoryFormat::kEuroc);
+    const auto left = body_to_sensor(read_trajectory(path, TrajectoryFormat::kEuroc), cam0_.T_BS);
     // Keep the samples that overlap the selected frames (half a frame of slack at both ends).
     const double slack = 0.5 / std::max(fps(), 1.0);
     Trajectory gt;
-    for (const auto& sp : body) {
-      if (sp.t < timestamps_.front() - slack || sp.t > timestamps_.back() + slack) continue;
-      gt.push_back({sp.t, sp.T * cam0_.T_BS});
-    }
+    std::copy_if(left.begin(), left.end(), std::back_inserter(gt), [&](const StampedPose& sp) {
+      return sp.t >= timestamps_.front() - slack && sp.t <= timestamps_.back() + slack;
+    });
     if (gt.empty()) {
       spdlog::warn("{}: no ground truth overlaps the selected frames", path.string());
       return;

@@ -107,6 +107,13 @@ EurocCameraSensor read_euroc_camera_yaml(const fs::path& path) {
   return s;
 }
 
+Trajectory body_to_sensor(const Trajectory& body, const Eigen::Isometry3d& T_BS) {
+  Trajectory out;
+  out.reserve(body.size());
+  for (const auto& sp : body) out.push_back({sp.t, sp.T * T_BS});
+  return out;
+}
+
 Eigen::Isometry3d read_euroc_T_BS(const fs::path& path) { return parse_T_BS(load_yaml(path), path); }
 
 }  // namespace plslam::io

@@ -6,6 +6,8 @@
 
 #include <Eigen/Geometry>
 
+#include "plslam/core/types.h"
+
 namespace plslam::io {
 
 struct EurocCameraSensor {
@@ -23,5 +25,9 @@ EurocCameraSensor read_euroc_camera_yaml(const std::filesystem::path& path);
 
 // Reads only T_BS, for files such as a body-to-camera argument of `plslam eval`.
 Eigen::Isometry3d read_euroc_T_BS(const std::filesystem::path& path);
+
+// Re-expresses a body-frame trajectory (T_world_body) as the trajectory of a sensor mounted at
+// T_BS: T_world_sensor = T_world_body * T_BS.
+Trajectory body_to_sensor(const Trajectory& body, const Eigen::Isometry3d& T_BS);
 
 }  // namespace plslam::io
