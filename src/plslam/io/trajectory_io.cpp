@@ -56,7 +56,8 @@ Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& M) {
 void check_increasing(const Trajectory& traj, const std::vector<NumericRow>& rows,
                       const std::filesystem::path& path) {
   for (std::size_t i = 1; i < traj.size(); ++i) {
-    if (!(traj[i].t > traj[i - 1].t)) {
+    // Repeated stamps are tolerated, as evo does: real files have them (evo's own V102.txt).
+    if (!(traj[i].t >= traj[i - 1].t)) {
       throw InputError(path.string(), where(rows[i].line) +
                                           fmt::format("timestamp {} is not after {}", traj[i].t, traj[i - 1].t));
     }

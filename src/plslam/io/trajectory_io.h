@@ -25,7 +25,7 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& path);
 
 // Reads a trajectory. KITTI files have no times: `kitti_times` supplies them when given (same
 // length required), otherwise frame i gets t = i. Any malformed line, wrong column count, NaN or
-// non-increasing timestamp throws InputError naming the file and line.
+// decreasing timestamp throws InputError naming the file and line (equal stamps are accepted).
 Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat format,
                            const std::vector<double>* kitti_times = nullptr);
 
