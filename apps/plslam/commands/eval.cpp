@@ -39,8 +39,10 @@ int run(const Options& o) {
   using plslam::io::TrajectoryFormat;
   const TrajectoryFormat gt_format = resolve_format(o.gt_format, o.gt);
   const TrajectoryFormat est_format = resolve_format(o.est_format, o.est);
-  plslam::Trajectory gt = plslam::io::read_trajectory(o.gt, gt_format);
-  plslam::Trajectory est = plslam::io::read_trajectory(o.est, est_format);
+  // KITTI rotations as written, as evo and the devkit use them, so the numbers agree with theirs.
+  constexpr auto kAsWritten = plslam::io::KittiRotation::kAsWritten;
+  plslam::Trajectory gt = plslam::io::read_trajectory(o.gt, gt_format, nullptr, kAsWritten);
+  plslam::Trajectory est = plslam::io::read_trajectory(o.est, est_format, nullptr, kAsWritten);
   if (!o.gt_body_to_cam.empty()) {
     gt = plslam::eval::body_to_camera(gt, plslam::eval::read_euroc_T_BS(o.gt_body_to_cam));
   }

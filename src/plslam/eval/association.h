@@ -14,7 +14,8 @@ struct IndexPairs {
 
 // evo's associate_trajectories: each stamp of the shorter list (the estimate when both are equally
 // long) is matched to the nearest stamp of the longer one, the first on a tie, and kept when
-// |dt| <= max_diff. A stamp of the longer list may thus be used twice. Both lists must be sorted.
+// |dt| <= max_diff. A stamp of the longer list may thus be used twice. Both lists must be sorted
+// (repeated stamps allowed).
 IndexPairs associate_by_time(const std::vector<double>& gt_times,
                              const std::vector<double>& est_times, double max_diff);
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <Eigen/LU>
 #include <fmt/format.h>
 
 #include "plslam/core/error.h"
@@ -39,11 +40,13 @@ KittiMetric kitti_odometry_metric(const Trajectory& gt, const Trajectory& est) {
                                        dist[first] + len);
       if (it == dist.end()) continue;
       const std::size_t last = static_cast<std::size_t>(it - dist.begin());
-      const Eigen::Isometry3d delta_gt = gt[first].T.inverse() * gt[last].T;
-      const Eigen::Isometry3d delta_est = est[first].T.inverse() * est[last].T;
-      const Eigen::Isometry3d error = delta_est.inverse() * delta_gt;
-      m.segments.push_back({first, last, len, error.translation().norm() / len,
-                            devkit_rotation_error(error.linear()) / len});
+      // General 4x4 inverses, as the devkit's Matrix::inv: poses read as written from KITTI files
+      // are not exactly rigid, and the trace-based angle is sensitive to that.
+      const Eigen::Matrix4d delta_gt = gt[first].T.matrix().inverse() * gt[last].T.matrix();
+      const Eigen::Matrix4d delta_est = est[first].T.matrix().inverse() * est[last].T.matrix();
+      const Eigen::Matrix4d error = delta_est.inverse() * delta_gt;
+      m.segments.push_back({first, last, len, error.topRightCorner<3, 1>().norm() / len,
+                            devkit_rotation_error(error.topLeftCorner<3, 3>()) / len});
     }
   }
   if (m.segments.empty()) {

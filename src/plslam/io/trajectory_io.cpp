@@ -110,7 +110,7 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& path) {
 }
 
 Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat format,
-                           const std::vector<double>* kitti_times) {
+                           const std::vector<double>* kitti_times, KittiRotation kitti_rotation) {
   const auto rows = read_numeric_rows(path);
   if (rows.empty()) throw InputError(path.string(), "empty trajectory file");
   Trajectory traj;
@@ -150,7 +150,7 @@ Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat f
           throw InputError(path.string(), where(r.line) + "rotation part is not a rotation");
         }
         Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-        T.linear() = nearest_rotation(M);
+        T.linear() = kitti_rotation == KittiRotation::kAsWritten ? M : nearest_rotation(M);
         T.translation() = p;
         traj.push_back({kitti_times ? (*kitti_times)[i] : static_cast<double>(i), T});
       }
