@@ -1,6 +1,7 @@
 #include "plslam/eval/chart.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -164,6 +165,7 @@ void Chart::draw(cv::Mat& canvas) const {
     dashed_line(plot, {0, py}, {static_cast<double>(area.width), py}, h.style);
   }
   constexpr int kShift = 4;  // sub-pixel precision for polylines
+  std::vector<cv::Point> drawn;  // plot-area pixels with data, to keep the legend off them
   for (const auto& l : lines_) {
     std::vector<cv::Point> pts;
     pts.reserve(l.points.size());
@@ -171,6 +173,8 @@ void Chart::draw(cv::Mat& canvas) const {
       const cv::Point2d q = (to_px(p) - origin) * (1 << kShift);
       pts.emplace_back(static_cast<int>(std::lround(q.x)), static_cast<int>(std::lround(q.y)));
     }
+    const std::size_t stride = std::max<std::size_t>(1, pts.size() / 5000);
+    for (std::size_t i = 0; i < pts.size(); i += stride) drawn.emplace_back(pts[i].x >> kShift, pts[i].y >> kShift);
     if (pts.size() == 1) {
       cv::circle(plot, pts[0], 3 << kShift, l.style.color, cv::FILLED, cv::LINE_AA, kShift);
     } else if (l.style.dashed) {
@@ -210,7 +214,22 @@ void Chart::draw(cv::Mat& canvas) const {
   for (const auto& e : entries) width = std::max(width, text_size(e.first, kTickScale).width);
   for (const auto* m : marker_entries) width = std::max(width, text_size(m->label, kTickScale).width);
   const int row = 20;
-  const cv::Rect box(area.x + area.width - width - 62, area.y + 8, width + 54, static_cast<int>(n) * row + 8);
+  const cv::Size box_size(width + 54, static_cast<int>(n) * row + 8);
+  // The corner of the plot area that hides the fewest data points (top-right on a tie).
+  const int xr = area.width - box_size.width - 8, yb = area.height - box_size.height - 8;
+  const std::array<cv::Point, 4> corners = {cv::Point(xr, 8), cv::Point(8, 8), cv::Point(xr, yb), cv::Point(8, yb)};
+  std::size_t best_hidden = std::numeric_limits<std::size_t>::max();
+  cv::Rect box;
+  for (const auto& c : corners) {
+    const cv::Rect candidate(c, box_size);
+    const auto hidden = static_cast<std::size_t>(std::count_if(
+        drawn.begin(), drawn.end(), [&](const cv::Point& p) { return candidate.contains(p); }));
+    if (hidden < best_hidden) {
+      best_hidden = hidden;
+      box = candidate + area.tl();
+    }
+  }
+  box &= cv::Rect(0, 0, canvas.cols, canvas.rows);
   canvas(box).setTo(kWhite);
   cv::rectangle(canvas, box, cv::Scalar(160, 160, 160), 1);
   int y = box.y + 4 + row / 2;

@@ -96,7 +96,7 @@ std::string format_report(const EvalResult& r) {
   out += stats_line("APE trans", "m", r.ape_trans_stats);
   const auto& o = r.rpe_options;
   out += fmt::format("RPE delta      {} {}, {} pairs ({} compared)\n", o.delta,
-                     o.unit == DeltaUnit::kFrames ? "frames" : "m",
+                     o.unit == DeltaUnit::kMeters ? "m" : o.delta == 1.0 ? "frame" : "frames",
                      o.all_pairs ? "all" : "consecutive", r.rpe.pairs.size());
   out += stats_line("RPE trans", "m", r.rpe_trans_stats);
   out += stats_line("RPE rot", "deg", r.rpe_rot_stats);

@@ -115,7 +115,7 @@ std::vector<std::filesystem::path> write_plots(const EvalResult& r, const std::f
     }
     const auto& o = r.rpe_options;
     const std::string delta = fmt::format("delta {} {}, {} pairs", o.delta,
-                                          o.unit == DeltaUnit::kFrames ? "frames" : "m",
+                                          o.unit == DeltaUnit::kMeters ? "m" : o.delta == 1.0 ? "frame" : "frames",
                                           o.all_pairs ? "all" : "consecutive");
     cv::Mat img(800, 1100, CV_8UC3);
     Chart ct;
