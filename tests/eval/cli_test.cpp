@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "eval/synthetic_trajectories.h"
-#include "plslam/eval/body_to_cam.h"
+#include "plslam/io/euroc_sensor.h"
 #include "plslam/io/trajectory_io.h"
 #include "support/test_support.h"
 
@@ -113,13 +113,13 @@ TEST(EvalCli, PlotsOfTheReferenceTrajectories) {
 TEST(EvalCli, BodyToCamTurnsEurocGroundTruthIntoCameraPoses) {
   PLSLAM_REQUIRE_SHARED_DATA(data);
   const auto yaml = data / "euroc" / "V1_01_easy_micro" / "mav0" / "cam0" / "sensor.yaml";
-  const Eigen::Isometry3d T_BS = read_euroc_T_BS(yaml);
+  const Eigen::Isometry3d T_BS = io::read_euroc_T_BS(yaml);
   EXPECT_NEAR(T_BS(0, 3), -0.0216401454975, 1e-12);
   EXPECT_NEAR(T_BS(1, 0), 0.999557249008, 1e-6);
   plslam::test::TempDir dir;
   const Trajectory body = test::helix(100);
   io::write_trajectory(dir.path() / "gt.csv", body, TrajectoryFormat::kEuroc);
-  io::write_trajectory(dir.path() / "cam.tum", body_to_camera(body, T_BS), TrajectoryFormat::kTum);
+  io::write_trajectory(dir.path() / "cam.tum", io::body_to_sensor(body, T_BS), TrajectoryFormat::kTum);
   const std::string base = "eval --gt " + q(dir.path() / "gt.csv") + " --est " + q(dir.path() / "cam.tum") +
                            " --align none --json";
   const auto with = run_cli(base + " --gt-body-to-cam " + q(yaml));

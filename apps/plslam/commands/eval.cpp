@@ -9,7 +9,7 @@
 
 #include "command_registry.h"
 #include "plslam/core/error.h"
-#include "plslam/eval/body_to_cam.h"
+#include "plslam/io/euroc_sensor.h"
 #include "plslam/eval/evaluate.h"
 #include "plslam/eval/plots.h"
 #include "plslam/io/trajectory_io.h"
@@ -44,7 +44,7 @@ int run(const Options& o) {
   plslam::Trajectory gt = plslam::io::read_trajectory(o.gt, gt_format, nullptr, kAsWritten);
   plslam::Trajectory est = plslam::io::read_trajectory(o.est, est_format, nullptr, kAsWritten);
   if (!o.gt_body_to_cam.empty()) {
-    gt = plslam::eval::body_to_camera(gt, plslam::eval::read_euroc_T_BS(o.gt_body_to_cam));
+    gt = plslam::io::body_to_sensor(gt, plslam::io::read_euroc_T_BS(o.gt_body_to_cam));
   }
 
   plslam::eval::EvalOptions options;
