@@ -137,9 +137,11 @@ PoseOnlyResult optimize_pose(const geometry::StereoCamera& cam, const SE3& T_cw_
     for (int it = 0; it < options.iterations_per_round; ++it) {
       ++res.iterations;
       const Matrix6d Hs = H.selfadjointView<Eigen::Lower>();
-      if (lambda < 0.0) lambda = 1e-5 * Hs.diagonal().maxCoeff();
+      if (lambda < 0.0) lambda = 1e-5;
+      // Marquardt's scaled damping; the tiny absolute term keeps A invertible when a
+      // direction is unobserved (e.g. a single line).
       Matrix6d A = Hs;
-      A.diagonal() += lambda * (Vector6d::Ones() + Hs.diagonal());
+      A.diagonal() += lambda * Hs.diagonal() + Vector6d::Constant(1e-12 * Hs.diagonal().maxCoeff());
       const Vector6d delta = A.ldlt().solve(-g);
       if (!delta.allFinite()) break;
       const SE3 T_new = SE3::exp(delta) * T;
@@ -147,14 +149,14 @@ PoseOnlyResult optimize_pose(const geometry::StereoCamera& cam, const SE3& T_cw_
           evaluate(p, T_new, res.point_outlier, res.line_outlier, robust, nullptr, nullptr);
       if (new_cost < cost) {
         T = T_new;
-        lambda = std::max(lambda / 3.0, 1e-12);
+        lambda = std::max(lambda / 3.0, 1e-9);
         if (delta.squaredNorm() < 1e-20) break;  // converged
         H.setZero();
         g.setZero();
         cost = evaluate(p, T, res.point_outlier, res.line_outlier, robust, &H, &g);
       } else {
         lambda *= 4.0;
-        if (lambda > 1e12) break;
+        if (lambda > 1e8) break;
       }
     }
     res.final_cost = classify(p, T, &res.point_outlier, &res.line_outlier);
