@@ -148,3 +148,91 @@ inline double centre_error(const geometry::SE3& A, const geometry::SE3& B) {
 }
 
 }  // namespace plslam::test
+
+#include "plslam/optim/bundle_adjustment.h"
+
+namespace plslam::test {
+
+// A forward-moving stereo rig (about 1 m between keyframes, gentle yaw) observing points and
+// segments; every landmark is observed by every keyframe that sees it inside the image.
+struct BaScene {
+  std::vector<geometry::SE3> poses_true;
+  std::vector<Eigen::Vector3d> points_true;
+  std::vector<geometry::Segment3d> lines_true;
+  optim::BaProblem problem;  // observations exact; initial state = ground truth (perturb it)
+};
+
+inline BaScene make_ba_scene(const geometry::StereoCamera& cam, int n_keyframes, int n_points,
+                             int n_lines, std::mt19937& rng) {
+  BaScene s;
+  for (int k = 0; k < n_keyframes; ++k) {
+    const double yaw = 0.03 * k;
+    geometry::Vector6d xi;
+    xi << 0.2 * std::sin(0.5 * k), 0.05 * k, 1.0 * k, 0.0, yaw, 0.01 * k;
+    // xi parameterises T_wc; the problem wants T_cw.
+    const geometry::SE3 T_wc(geometry::so3_exp(xi.tail<3>()), xi.head<3>());
+    s.poses_true.push_back(T_wc.inverse());
+    s.problem.keyframes.push_back({T_wc.inverse(), false});
+  }
+  std::uniform_int_distribution<int> pick(0, n_keyframes - 1);
+  const auto visible = [&](const geometry::SE3& T, const Eigen::Vector3d& X) {
+    const Eigen::Vector3d Xc = T * X;
+    return Xc.z() > 0.5 && cam.in_image(cam.project(Xc), 1.0) &&
+           cam.in_image({cam.project_stereo(Xc)(2), cam.project(Xc).y()}, 1.0);
+  };
+  while (static_cast<int>(s.points_true.size()) < n_points) {
+    const int k0 = pick(rng);
+    const Eigen::Vector3d X = world_point_at(cam, s.poses_true[static_cast<std::size_t>(k0)],
+                                             random_pixel(cam, rng), random_depth(rng, 3.0, 40.0));
+    std::vector<int> seen;
+    for (int k = 0; k < n_keyframes; ++k) {
+      if (visible(s.poses_true[static_cast<std::size_t>(k)], X)) seen.push_back(k);
+    }
+    if (seen.size() < 2) continue;
+    const int id = static_cast<int>(s.points_true.size());
+    s.points_true.push_back(X);
+    s.problem.points.push_back({X, false});
+    for (const int k : seen) {
+      optim::StereoPointObservation o = observe_point(cam, s.poses_true[static_cast<std::size_t>(k)], X, 0.0, rng);
+      o.keyframe = k;
+      o.point = id;
+      s.problem.point_observations.push_back(o);
+    }
+  }
+  while (static_cast<int>(s.lines_true.size()) < n_lines) {
+    const int k0 = pick(rng);
+    const auto [A, B] = random_segment(cam, s.poses_true[static_cast<std::size_t>(k0)], rng);
+    std::vector<int> seen;
+    for (int k = 0; k < n_keyframes; ++k) {
+      const auto& T = s.poses_true[static_cast<std::size_t>(k)];
+      if (visible(T, A) && visible(T, B)) seen.push_back(k);
+    }
+    if (seen.size() < 2) continue;
+    const int id = static_cast<int>(s.lines_true.size());
+    s.lines_true.push_back({A, B});
+    s.problem.lines.push_back({A, B, false});
+    for (const int k : seen) {
+      optim::StereoLineObservation o = observe_line(cam, s.poses_true[static_cast<std::size_t>(k)], A, B, 0.0, rng);
+      o.keyframe = k;
+      o.line = id;
+      s.problem.line_observations.push_back(o);
+    }
+  }
+  return s;
+}
+
+// Noisy initial state: poses off by ~trans / rot, landmarks by ~landmark_noise metres.
+inline void perturb(optim::BaProblem* p, double trans, double rot, double landmark_noise,
+                    std::mt19937& rng) {
+  std::normal_distribution<double> g(0.0, landmark_noise);
+  for (auto& kf : p->keyframes) {
+    if (!kf.fixed) kf.T_cw = random_pose(rng, trans, rot) * kf.T_cw;
+  }
+  for (auto& pt : p->points) pt.position += Eigen::Vector3d(g(rng), g(rng), g(rng));
+  for (auto& l : p->lines) {
+    l.start += Eigen::Vector3d(g(rng), g(rng), g(rng));
+    l.end += Eigen::Vector3d(g(rng), g(rng), g(rng));
+  }
+}
+
+}  // namespace plslam::test

@@ -23,7 +23,7 @@ using geometry::SE3;
 struct State {
   std::vector<PoseParams> poses;
   std::vector<Eigen::Vector3d> points;
-  std::vector<Eigen::Vector3d> starts, ends;
+  std::vector<Eigen::Matrix<double, 6, 1>> lines;  // [start; end]
 };
 
 void check_indices(const BaProblem& p) {
@@ -69,7 +69,8 @@ Gates gate(const geometry::StereoCamera& cam, const BaProblem& p, const BaOption
     const SE3 T = from_params(s.poses[static_cast<std::size_t>(o.keyframe)].data());
     const auto li = static_cast<std::size_t>(o.line);
     bool out = true;
-    if (evaluate_stereo_line(cam, T, s.starts[li], s.ends[li], o, &rl, nullptr, nullptr, nullptr)) {
+    const Eigen::Vector3d Ps = s.lines[li].head<3>(), Pe = s.lines[li].tail<3>();
+    if (evaluate_stereo_line(cam, T, Ps, Pe, o, &rl, nullptr, nullptr, nullptr)) {
       const double info = o.information * level_information(o.level, opt.scale_factor);
       out = info * rl.head<2>().squaredNorm() > opt.chi2_line_pair ||
             info * rl.tail<2>().squaredNorm() > opt.chi2_line_pair;
@@ -106,10 +107,11 @@ ceres::Solver::Summary solve_pass(const geometry::StereoCamera& cam, const BaPro
     return x;
   };
   std::vector<bool> point_added(p.points.size(), false);
-  auto add_landmark = [&](double* x, bool fixed, std::vector<bool>& added, std::size_t k) {
+  auto add_landmark = [&](double* x, int size, bool fixed, std::vector<bool>& added,
+                          std::size_t k) {
     if (!added[k]) {
       added[k] = true;
-      problem.AddParameterBlock(x, 3);
+      problem.AddParameterBlock(x, size);
       if (fixed) problem.SetParameterBlockConstant(x);
       ordering->AddElementToGroup(x, 0);
     }
@@ -119,26 +121,25 @@ ceres::Solver::Summary solve_pass(const geometry::StereoCamera& cam, const BaPro
     const auto& o = p.point_observations[k];
     const auto pi = static_cast<std::size_t>(o.point);
     double* pose = add_pose(o.keyframe);
-    add_landmark(s->points[pi].data(), p.points[pi].fixed, point_added, pi);
+    add_landmark(s->points[pi].data(), 3, p.points[pi].fixed, point_added, pi);
     const double sqrt_info = std::sqrt(level_information(o.level, opt.scale_factor));
     ceres::LossFunction* loss = robust ? (o.has_right ? &point_loss : &mono_loss) : nullptr;
     problem.AddResidualBlock(new StereoPointCost(cam, o, sqrt_info), loss, pose,
                              s->points[pi].data());
   }
-  std::vector<bool> start_added(p.lines.size(), false), end_added(p.lines.size(), false);
+  std::vector<bool> line_added(p.lines.size(), false);
   for (std::size_t k = 0; k < p.line_observations.size(); ++k) {
     if (excluded && excluded->line_out[k]) continue;
     const auto& o = p.line_observations[k];
     const auto li = static_cast<std::size_t>(o.line);
     double* pose = add_pose(o.keyframe);
-    add_landmark(s->starts[li].data(), p.lines[li].fixed, start_added, li);
-    add_landmark(s->ends[li].data(), p.lines[li].fixed, end_added, li);
+    add_landmark(s->lines[li].data(), 6, p.lines[li].fixed, line_added, li);
     const double sqrt_info =
         std::sqrt(o.information * level_information(o.level, opt.scale_factor));
     ceres::LossFunction* loss = robust ? &line_loss : nullptr;
     for (const bool right : {false, true}) {
       problem.AddResidualBlock(new StereoLinePairCost(cam, o, right, sqrt_info), loss, pose,
-                               s->starts[li].data(), s->ends[li].data());
+                               s->lines[li].data());
     }
   }
 
@@ -167,8 +168,8 @@ BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& p,
   for (const auto& kf : p.keyframes) s.poses.push_back(to_params(kf.T_cw));
   for (const auto& pt : p.points) s.points.push_back(pt.position);
   for (const auto& l : p.lines) {
-    s.starts.push_back(l.start);
-    s.ends.push_back(l.end);
+    s.lines.emplace_back();
+    s.lines.back() << l.start, l.end;
   }
 
   BaResult res;
@@ -177,12 +178,14 @@ BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& p,
   res.final_cost = first.final_cost;
   res.iterations = static_cast<int>(first.iterations.size());
   res.usable = first.IsSolutionUsable();
+  res.message = first.BriefReport() + " " + first.message;
   if (opt.remove_outliers && opt.second_pass_iterations > 0) {
     const Gates g = gate(cam, p, opt, s);
     const auto second = solve_pass(cam, p, opt, false, opt.second_pass_iterations, &g, &s);
     res.final_cost = second.final_cost;
     res.iterations += static_cast<int>(second.iterations.size());
     res.usable = res.usable && second.IsSolutionUsable();
+    res.message = second.BriefReport() + " " + second.message;
   }
   Gates final_gates = gate(cam, p, opt, s);
   res.point_observation_outlier = std::move(final_gates.point_out);
@@ -191,7 +194,7 @@ BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& p,
     res.poses.push_back(p.keyframes[k].fixed ? p.keyframes[k].T_cw : from_params(s.poses[k].data()));
   }
   res.points = std::move(s.points);
-  for (std::size_t l = 0; l < p.lines.size(); ++l) res.lines.push_back({s.starts[l], s.ends[l]});
+  for (const auto& l : s.lines) res.lines.push_back({l.head<3>(), l.tail<3>()});
   return res;
 }
 

@@ -3,6 +3,7 @@
 // Schur-complement solver (landmarks eliminated first). The problem is plain data: keyframe
 // poses T_cw with fixed flags, landmarks, and observations indexing them. A local BA is this
 // problem restricted to a window, with the covisible keyframes outside it marked fixed.
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -68,6 +69,7 @@ struct BaResult {
   double final_cost = 0.0;    // ... at the end of the last pass
   int iterations = 0;
   bool usable = false;  // Ceres produced a usable solution
+  std::string message;  // Ceres' brief report of the last pass (for logs)
 };
 
 // Throws InputError when an observation indexes outside the problem's arrays.

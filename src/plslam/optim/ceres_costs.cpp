@@ -78,15 +78,14 @@ bool StereoLinePairCost::Evaluate(double const* const* params, double* residuals
                                   double** jacobians) const {
   const SE3 T = from_params(params[0]);
   const Eigen::Map<const Eigen::Vector3d> Ps(params[1]);
-  const Eigen::Map<const Eigen::Vector3d> Pe(params[2]);
+  const Eigen::Map<const Eigen::Vector3d> Pe(params[1] + 3);
   Eigen::Vector4d r;
   Matrix46d Jp;
   Matrix43d Js, Je;
   const bool jp = jacobians && jacobians[0];
-  const bool js = jacobians && jacobians[1];
-  const bool je = jacobians && jacobians[2];
-  if (!evaluate_stereo_line(cam_, T, Ps, Pe, obs_, &r, jp ? &Jp : nullptr, js ? &Js : nullptr,
-                            je ? &Je : nullptr)) {
+  const bool jl = jacobians && jacobians[1];
+  if (!evaluate_stereo_line(cam_, T, Ps, Pe, obs_, &r, jp ? &Jp : nullptr, jl ? &Js : nullptr,
+                            jl ? &Je : nullptr)) {
     return false;
   }
   const int row = right_ ? 2 : 0;
@@ -97,13 +96,10 @@ bool StereoLinePairCost::Evaluate(double const* const* params, double* residuals
     J.leftCols<6>() = sqrt_info_ * Jp.middleRows<2>(row);
     J.col(6).setZero();
   }
-  if (js) {
-    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> out_map(jacobians[1]);
-    out_map = sqrt_info_ * Js.middleRows<2>(row);
-  }
-  if (je) {
-    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> out_map(jacobians[2]);
-    out_map = sqrt_info_ * Je.middleRows<2>(row);
+  if (jl) {
+    Eigen::Map<Eigen::Matrix<double, 2, 6, Eigen::RowMajor>> J(jacobians[1]);
+    J.leftCols<3>() = sqrt_info_ * Js.middleRows<2>(row);
+    J.rightCols<3>() = sqrt_info_ * Je.middleRows<2>(row);
   }
   return true;
 }

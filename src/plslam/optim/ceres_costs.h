@@ -44,8 +44,9 @@ class StereoPointCost final : public ceres::SizedCostFunction<3, 7, 3> {
 };
 
 // One image's pair of the stereo line residual (rows 0-1: left image, rows 2-3: right image),
-// whitened by sqrt(info); blocks: pose, start point, end point.
-class StereoLinePairCost final : public ceres::SizedCostFunction<2, 7, 3, 3> {
+// whitened by sqrt(info); blocks: pose, endpoints [P_s; P_e] (one 6-vector, so that a line is a
+// single block the Schur complement can eliminate).
+class StereoLinePairCost final : public ceres::SizedCostFunction<2, 7, 6> {
  public:
   StereoLinePairCost(const geometry::StereoCamera& cam, const StereoLineObservation& obs,
                      bool right_image, double sqrt_info)
