@@ -43,8 +43,10 @@ double evaluate(const Problem& p, const SE3& T, const std::vector<bool>& point_o
     cost += robust ? h.rho(s) : s;
     if (jac) {
       const double w = info * (robust ? h.weight(s) : 1.0);
-      H->selfadjointView<Eigen::Lower>().rankUpdate(J.transpose(), w);
-      g->noalias() += w * J.transpose() * r;
+      // Fixed-size products (rankUpdate on a 6x3 takes Eigen's slow general-product path).
+      const Eigen::Matrix<double, 6, 3> wJt = w * J.transpose();
+      H->noalias() += wJt.lazyProduct(J);
+      g->noalias() += wJt * r;
     }
   }
   Eigen::Vector4d rl;
@@ -65,9 +67,10 @@ double evaluate(const Problem& p, const SE3& T, const std::vector<bool>& point_o
       cost += robust ? hl.rho(s) : s;
       if (jac) {
         const double w = info * (robust ? hl.weight(s) : 1.0);
-        const auto Jp = Jl.middleRows<2>(2 * pair);
-        H->selfadjointView<Eigen::Lower>().rankUpdate(Jp.transpose(), w);
-        g->noalias() += w * Jp.transpose() * rp;
+        const Eigen::Matrix<double, 2, 6> Jp = Jl.middleRows<2>(2 * pair);
+        const Eigen::Matrix<double, 6, 2> wJt = w * Jp.transpose();
+        H->noalias() += wJt.lazyProduct(Jp);
+        g->noalias() += wJt * rp;
       }
     }
   }
@@ -126,8 +129,12 @@ PoseOnlyResult optimize_pose(const geometry::StereoCamera& cam, const SE3& T_cw_
   res.line_outlier.assign(lines.size(), false);
   SE3 T = T_cw_init;
 
+  bool changed = true;  // did the last classification change any flag?
   for (int round = 0; round < options.rounds; ++round) {
     const bool robust = round < options.robust_rounds;
+    // Same active set and same kernel as the round just finished: it would start at its own
+    // converged optimum and end with the same classification, so skip it.
+    if (round > 0 && !changed && robust == (round - 1 < options.robust_rounds)) continue;
     double lambda = -1.0;
     Matrix6d H;
     Vector6d g;
@@ -136,7 +143,7 @@ PoseOnlyResult optimize_pose(const geometry::StereoCamera& cam, const SE3& T_cw_
     double cost = evaluate(p, T, res.point_outlier, res.line_outlier, robust, &H, &g);
     for (int it = 0; it < options.iterations_per_round; ++it) {
       ++res.iterations;
-      const Matrix6d Hs = H.selfadjointView<Eigen::Lower>();
+      const Matrix6d& Hs = H;
       if (lambda < 0.0) lambda = 1e-5;
       // Marquardt's scaled damping; the tiny absolute term keeps A invertible when a
       // direction is unobserved (e.g. a single line).
@@ -145,21 +152,29 @@ PoseOnlyResult optimize_pose(const geometry::StereoCamera& cam, const SE3& T_cw_
       const Vector6d delta = A.ldlt().solve(-g);
       if (!delta.allFinite()) break;
       const SE3 T_new = SE3::exp(delta) * T;
+      // The normal equations at T_new come with its cost in the same pass: steps are rarely
+      // rejected, so this saves a full cost-only pass per iteration.
+      Matrix6d H_new = Matrix6d::Zero();
+      Vector6d g_new = Vector6d::Zero();
       const double new_cost =
-          evaluate(p, T_new, res.point_outlier, res.line_outlier, robust, nullptr, nullptr);
+          evaluate(p, T_new, res.point_outlier, res.line_outlier, robust, &H_new, &g_new);
       if (new_cost < cost) {
         T = T_new;
         lambda = std::max(lambda / 3.0, 1e-9);
-        if (delta.squaredNorm() < 1e-20) break;  // converged
-        H.setZero();
-        g.setZero();
-        cost = evaluate(p, T, res.point_outlier, res.line_outlier, robust, &H, &g);
+        const double old_cost = cost;
+        cost = new_cost;
+        H = H_new;
+        g = g_new;
+        // Converged: a sub-micrometre / sub-microradian step or a negligible cost decrease.
+        if (delta.squaredNorm() < 1e-12 || old_cost - new_cost < 1e-9 * old_cost) break;
       } else {
         lambda *= 4.0;
         if (lambda > 1e8) break;
       }
     }
+    const std::vector<bool> prev_points = res.point_outlier, prev_lines = res.line_outlier;
     res.final_cost = classify(p, T, &res.point_outlier, &res.line_outlier);
+    changed = prev_points != res.point_outlier || prev_lines != res.line_outlier;
   }
   res.T_cw = T;
   for (const bool o : res.point_outlier) res.num_point_inliers += o ? 0 : 1;
