@@ -48,6 +48,7 @@ void BM_BundleAdjustment(benchmark::State& state) {
   opt.linear_solver = state.range(0) == 0 ? optim::BaLinearSolver::kDenseSchur
                                           : optim::BaLinearSolver::kSparseSchur;
   opt.remove_outliers = state.range(1) != 0;
+  opt.num_threads = static_cast<int>(state.range(2));
   double err = 0.0;
   for (auto _ : state) {
     const auto res = optim::bundle_adjust(cam, scene.problem, opt);
@@ -61,8 +62,9 @@ void BM_BundleAdjustment(benchmark::State& state) {
   state.counters["line_obs"] = static_cast<double>(scene.problem.line_observations.size());
   state.counters["max_pose_err_mm"] = err * 1e3;
 }
-// Args: {0 dense / 1 sparse Schur, second pass with outlier removal}
-BENCHMARK(BM_BundleAdjustment)->Args({0, 0})->Args({1, 0})->Args({0, 1})
+// Args: {0 dense / 1 sparse Schur, second pass with outlier removal, threads}
+BENCHMARK(BM_BundleAdjustment)->Args({0, 0, 1})->Args({1, 0, 1})->Args({0, 1, 1})->Args({0, 0, 2})
+    ->UseRealTime()
     ->Unit(benchmark::kMillisecond)->Repetitions(3)->ReportAggregatesOnly(true);
 
 // Autodiff twins of the analytic costs, on the same 7-number pose block [t, q_xyzw].
