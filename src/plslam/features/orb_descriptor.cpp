@@ -1,0 +1,114 @@
+#include "plslam/features/orb_descriptor.h"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+#include <opencv2/core/fast_math.hpp>
+
+namespace plslam::features {
+namespace {
+
+// splitmix64: tiny, fully specified, so the pattern does not depend on the standard library's
+// distribution implementations.
+struct SplitMix64 {
+  uint64_t state;
+  uint64_t next() {
+    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return static_cast<double>(next() >> 11) * (1.0 / 9007199254740992.0); }  // [0,1)
+};
+
+std::array<std::array<int8_t, 4>, 256> make_pattern() {
+  SplitMix64 rng{0x5EEDB41EF00Dull};
+  const double sigma = 31.0 / 5.0;
+  auto gaussian_coordinate = [&]() -> int {
+    for (;;) {
+      // Box-Muller; one of the pair is enough.
+      const double u1 = 1.0 - rng.uniform(), u2 = rng.uniform();
+      const double g = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2) * sigma;
+      const long v = std::lround(g);
+      if (std::abs(v) <= kBriefPatternHalfExtent) return static_cast<int>(v);
+    }
+  };
+  std::array<std::array<int8_t, 4>, 256> pattern{};
+  for (auto& p : pattern) {
+    do {
+      for (auto& c : p) c = static_cast<int8_t>(gaussian_coordinate());
+    } while (p[0] == p[2] && p[1] == p[3]);  // a test of a pixel against itself carries no bit
+  }
+  return pattern;
+}
+
+// Half-widths of the disc rows: umax[v] = largest u with u^2 + v^2 <= r^2 (+0.5 for rounding).
+std::array<int, kOrbPatchRadius + 1> make_umax() {
+  std::array<int, kOrbPatchRadius + 1> umax{};
+  for (int v = 0; v <= kOrbPatchRadius; ++v)
+    umax[static_cast<std::size_t>(v)] =
+        static_cast<int>(std::floor(std::sqrt(kOrbPatchRadius * kOrbPatchRadius + 0.5 - v * v)));
+  return umax;
+}
+
+}  // namespace
+
+const std::array<std::array<int8_t, 4>, 256>& brief_pattern() {
+  static const auto pattern = make_pattern();
+  return pattern;
+}
+
+float intensity_centroid_angle(const cv::Mat& image, int x, int y) {
+  static const auto umax = make_umax();
+  const uchar* center = image.ptr<uchar>(y) + x;
+  const int step = static_cast<int>(image.step1());
+  int m10 = 0, m01 = 0;
+  for (int u = -kOrbPatchRadius; u <= kOrbPatchRadius; ++u) m10 += u * center[u];
+  // Rows v and -v together: their sum feeds m10, their difference m01.
+  for (int v = 1; v <= kOrbPatchRadius; ++v) {
+    int v_sum = 0;
+    const int d = umax[static_cast<std::size_t>(v)];
+    for (int u = -d; u <= d; ++u) {
+      const int below = center[u + v * step], above = center[u - v * step];
+      v_sum += below - above;
+      m10 += u * (below + above);
+    }
+    m01 += v * v_sum;
+  }
+  return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
+}
+
+void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
+  const auto& pattern = brief_pattern();
+  const float a = angle_deg * static_cast<float>(CV_PI / 180.0);
+  const float c = std::cos(a), s = std::sin(a);
+  const uchar* center = blurred.ptr<uchar>(y) + x;
+  const int step = static_cast<int>(blurred.step1());
+  auto sample = [&](int px, int py) {
+    const int rx = cvRound(static_cast<float>(px) * c - static_cast<float>(py) * s);
+    const int ry = cvRound(static_cast<float>(px) * s + static_cast<float>(py) * c);
+    return center[ry * step + rx];
+  };
+  for (int byte = 0; byte < kOrbDescriptorBytes; ++byte) {
+    uint8_t v = 0;
+    for (int bit = 0; bit < 8; ++bit) {
+      const auto& p = pattern[static_cast<std::size_t>(byte * 8 + bit)];
+      v |= static_cast<uint8_t>((sample(p[0], p[1]) < sample(p[2], p[3])) << bit);
+    }
+    out[byte] = v;
+  }
+}
+
+int hamming_distance(const uint8_t* a, const uint8_t* b) {
+  int d = 0;
+  for (int i = 0; i < kOrbDescriptorBytes; i += 8) {
+    uint64_t x, y;
+    std::memcpy(&x, a + i, 8);
+    std::memcpy(&y, b + i, 8);
+    d += std::popcount(x ^ y);
+  }
+  return d;
+}
+
+}  // namespace plslam::features

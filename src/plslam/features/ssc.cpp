@@ -1,0 +1,170 @@
+#include "plslam/features/ssc.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace plslam::features {
+
+// Derivation of the width bounds (the paper's equations 1-2 model the packing differently and
+// contain typos; these follow from the covering actually implemented below).
+//
+// The covering uses square cells of side c = w/2. A kept point in cell (i, j) covers cells
+// [i-2, i+2] x [j-2, j+2]. A later candidate survives only if its cell is at least 3 cells away
+// in x or in y, i.e. more than 2c = w pixels away in that axis: kept points are pairwise more
+// than w apart in the max-norm.
+//
+// Upper bound. Tile the W x H image with half-open boxes of side w: one box can hold at most
+// one kept point, and there are ceil(W/w) * ceil(H/w) <= (W/w + 1)(H/w + 1) boxes. Keeping N
+// points therefore needs (W + w)(H + w) >= N w^2, i.e. (N-1) w^2 - (W+H) w - W H <= 0, whose
+// positive root is
+//     w_high = ( (W+H) + sqrt((W+H)^2 + 4 (N-1) W H) ) / (2 (N-1)).
+// No input can give N points above w_high.
+//
+// Lower bound. A kept point covers 5 cells per axis, an interval of length 5c = 2.5 w holding at
+// most 2.5 w + 1 integer coordinates, so it removes at most (2.5 w + 1)^2 candidates at distinct
+// integer pixels (FAST corners of one level are). The greedy pass ends with every candidate kept
+// or covered, so K candidates leave at least K / (2.5 w + 1)^2 points, which is >= N when
+//     w <= w_low = (sqrt(K/N) - 1) / 2.5.
+// Widths under one pixel would make the grid larger than the image, so w_low is clamped to 1.
+SscBounds ssc_width_bounds(int candidates, int target, cv::Size size) {
+  const double W = size.width, H = size.height;
+  const double N = std::max(1, target);
+  SscBounds b;
+  b.high = N <= 1 ? std::max(W, H) + 1.0
+                  : ((W + H) + std::sqrt((W + H) * (W + H) + 4.0 * (N - 1.0) * W * H)) / (2.0 * (N - 1.0));
+  const double ratio = static_cast<double>(std::max(candidates, 1)) / N;
+  b.low = std::max(1.0, (std::sqrt(ratio) - 1.0) / 2.5);
+  b.high = std::max(b.high, b.low);
+  return b;
+}
+
+std::vector<int> order_by_response(const std::vector<cv::KeyPoint>& keypoints) {
+  const int n = static_cast<int>(keypoints.size());
+  std::vector<int> order(static_cast<std::size_t>(n));
+  constexpr int kBins = 1024;
+  const bool small_integers = std::all_of(keypoints.begin(), keypoints.end(), [](const cv::KeyPoint& k) {
+    return k.response >= 0.f && k.response < kBins && k.response == std::floor(k.response);
+  });
+  if (small_integers) {
+    // Counting sort, descending, stable: O(K) instead of O(K log K).
+    std::vector<int> start(kBins + 1, 0);
+    for (const auto& k : keypoints) ++start[static_cast<std::size_t>(kBins - 1 - static_cast<int>(k.response)) + 1];
+    for (int i = 0; i < kBins; ++i) start[static_cast<std::size_t>(i) + 1] += start[static_cast<std::size_t>(i)];
+    for (int i = 0; i < n; ++i) {
+      const int bin = kBins - 1 - static_cast<int>(keypoints[static_cast<std::size_t>(i)].response);
+      order[static_cast<std::size_t>(start[static_cast<std::size_t>(bin)]++)] = i;
+    }
+    return order;
+  }
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return keypoints[static_cast<std::size_t>(a)].response > keypoints[static_cast<std::size_t>(b)].response;
+  });
+  return order;
+}
+
+namespace {
+
+// One greedy covering pass at width w over candidates sorted strongest first. Stops once
+// `limit` points are kept (the caller only needs to know it overshot). Returns the kept count.
+class Coverer {
+ public:
+  Coverer(const std::vector<float>& xs, const std::vector<float>& ys, cv::Size size)
+      : xs_(xs), ys_(ys), size_(size) {}
+
+  int run(double w, int limit, std::vector<int>& kept_sorted_pos) {
+    const double c = w / 2.0;
+    const float inv_c = static_cast<float>(1.0 / c);
+    const int cols = static_cast<int>(std::ceil(size_.width / c)) + 1;
+    const int rows = static_cast<int>(std::ceil(size_.height / c)) + 1;
+    // Two margin cells on each side so covering a 5x5 block needs no bounds checks.
+    const int stride = cols + 4;
+    grid_.assign(static_cast<std::size_t>(stride) * static_cast<std::size_t>(rows + 4), 0);
+    kept_sorted_pos.clear();
+    const int n = static_cast<int>(xs_.size());
+    uint8_t* g = grid_.data();
+    for (int i = 0; i < n; ++i) {
+      const int cx = std::clamp(static_cast<int>(xs_[static_cast<std::size_t>(i)] * inv_c), 0, cols - 1) + 2;
+      const int cy = std::clamp(static_cast<int>(ys_[static_cast<std::size_t>(i)] * inv_c), 0, rows - 1) + 2;
+      uint8_t* cell = g + cy * stride + cx;
+      if (*cell) continue;
+      kept_sorted_pos.push_back(i);
+      if (static_cast<int>(kept_sorted_pos.size()) >= limit) break;
+      for (int dy = -2; dy <= 2; ++dy) {
+        uint8_t* row = cell + dy * stride;
+        row[-2] = row[-1] = row[0] = row[1] = row[2] = 1;
+      }
+    }
+    return static_cast<int>(kept_sorted_pos.size());
+  }
+
+ private:
+  const std::vector<float>& xs_;
+  const std::vector<float>& ys_;
+  cv::Size size_;
+  std::vector<uint8_t> grid_;
+};
+
+}  // namespace
+
+SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
+                     double tolerance_fraction) {
+  SscResult result;
+  const int k = static_cast<int>(keypoints.size());
+  if (target <= 0 || k == 0) return result;
+  const std::vector<int> order = order_by_response(keypoints);
+  if (k <= target) {
+    result.kept = order;
+    return result;
+  }
+  // Positions in visiting order, contiguous: the passes below are memory-bound.
+  std::vector<float> xs(static_cast<std::size_t>(k)), ys(static_cast<std::size_t>(k));
+  for (int i = 0; i < k; ++i) {
+    const auto& p = keypoints[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])].pt;
+    xs[static_cast<std::size_t>(i)] = std::max(p.x, 0.f);
+    ys[static_cast<std::size_t>(i)] = std::max(p.y, 0.f);
+  }
+  const int tolerance = static_cast<int>(std::floor(tolerance_fraction * target));
+  const SscBounds bounds = ssc_width_bounds(k, target, size);
+
+  Coverer cover(xs, ys, size);
+  std::vector<int> pass, best;
+  double best_width = 0;
+  // Integer widths, as in Bailo et al.: the count changes in steps anyway, and the search
+  // ends after log2(w_high) passes.
+  int low = static_cast<int>(std::floor(bounds.low));
+  int high = static_cast<int>(std::ceil(bounds.high));
+  bool done = false;
+  while (low <= high) {
+    const int w = low + (high - low) / 2;
+    const int count = cover.run(w, target + tolerance + 1, pass);
+    ++result.iterations;
+    if (std::abs(count - target) <= tolerance) {
+      best.swap(pass);
+      best_width = w;
+      done = true;
+      break;
+    }
+    if (count > target) {
+      best.swap(pass);  // feasible: remember it, then try wider
+      best_width = w;
+      low = w + 1;
+    } else {
+      high = w - 1;
+    }
+  }
+  if (!done && best.empty()) {
+    // Only possible with non-integer or duplicate positions: fall back to the narrowest cover.
+    cover.run(std::max(1, static_cast<int>(std::floor(bounds.low))), target, best);
+    best_width = std::max(1.0, std::floor(bounds.low));
+    ++result.iterations;
+  }
+  if (static_cast<int>(best.size()) > target + tolerance) best.resize(static_cast<std::size_t>(target));
+  result.width = best_width;
+  result.kept.reserve(best.size());
+  for (int pos : best) result.kept.push_back(order[static_cast<std::size_t>(pos)]);
+  return result;
+}
+
+}  // namespace plslam::features
