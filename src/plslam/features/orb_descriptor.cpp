@@ -80,22 +80,38 @@ float intensity_centroid_angle(const cv::Mat& image, int x, int y) {
 }
 
 void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
-  const auto& pattern = brief_pattern();
+  // The pattern as float columns, built once: the rotation below then runs as plain vector code.
+  struct Columns {
+    alignas(32) float x[512], y[512];
+  };
+  static const Columns cols = [] {
+    Columns c{};
+    const auto& p = brief_pattern();
+    for (std::size_t i = 0; i < 256; ++i) {
+      c.x[2 * i] = p[i][0];
+      c.y[2 * i] = p[i][1];
+      c.x[2 * i + 1] = p[i][2];
+      c.y[2 * i + 1] = p[i][3];
+    }
+    return c;
+  }();
   const float a = angle_deg * static_cast<float>(CV_PI / 180.0);
   const float c = std::cos(a), s = std::sin(a);
-  const uchar* center = blurred.ptr<uchar>(y) + x;
   const int step = static_cast<int>(blurred.step1());
-  auto sample = [&](int px, int py) {
-    const int rx = cvRound(static_cast<float>(px) * c - static_cast<float>(py) * s);
-    const int ry = cvRound(static_cast<float>(px) * s + static_cast<float>(py) * c);
-    return center[ry * step + rx];
-  };
+  alignas(32) int offset[512];
+  // Rounding by truncation of a shifted positive value (|coordinate| < 19), which vectorises
+  // without SSE4's round instruction.
+  constexpr float kShift = 64.5f;
+  for (int i = 0; i < 512; ++i) {
+    const int rx = static_cast<int>(cols.x[i] * c - cols.y[i] * s + kShift) - 64;
+    const int ry = static_cast<int>(cols.x[i] * s + cols.y[i] * c + kShift) - 64;
+    offset[i] = ry * step + rx;
+  }
+  const uchar* center = blurred.ptr<uchar>(y) + x;
   for (int byte = 0; byte < kOrbDescriptorBytes; ++byte) {
+    const int* o = offset + byte * 16;
     uint8_t v = 0;
-    for (int bit = 0; bit < 8; ++bit) {
-      const auto& p = pattern[static_cast<std::size_t>(byte * 8 + bit)];
-      v |= static_cast<uint8_t>((sample(p[0], p[1]) < sample(p[2], p[3])) << bit);
-    }
+    for (int bit = 0; bit < 8; ++bit) v |= static_cast<uint8_t>((center[o[2 * bit]] < center[o[2 * bit + 1]]) << bit);
     out[byte] = v;
   }
 }

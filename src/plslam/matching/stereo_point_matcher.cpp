@@ -23,28 +23,53 @@ void StereoPointOptions::validate() const {
 
 namespace {
 
-// SAD between the left window and the right window shifted by `shift`, after removing the
-// difference of the window means (robust to a gain offset between the cameras).
-int zero_mean_sad(const cv::Mat& left, int xl, int y, const cv::Mat& right, int xr, int hw) {
-  int sum_l = 0, sum_r = 0;
-  for (int dy = -hw; dy <= hw; ++dy) {
-    const uchar* pl = left.ptr<uchar>(y + dy) + xl;
-    const uchar* pr = right.ptr<uchar>(y + dy) + xr;
-    for (int dx = -hw; dx <= hw; ++dx) {
-      sum_l += pl[dx];
-      sum_r += pr[dx];
+// SAD of the left window against the right window at each of the 2L+1 shifts around xr0,
+// after removing the difference of the window means (robust to a gain offset between the
+// cameras). Windows are copied once into small buffers so each shift is a tight loop.
+class SadCurve {
+ public:
+  SadCurve(int half_window, int search)
+      : hw_(half_window), L_(search), win_(2 * half_window + 1), strip_(2 * search + win_),
+        left_(static_cast<std::size_t>(win_ * win_)), right_(static_cast<std::size_t>(win_ * strip_)),
+        colsum_(static_cast<std::size_t>(strip_)) {}
+
+  void compute(const cv::Mat& il, int xl, int y, const cv::Mat& ir, int xr0, int* sad) {
+    int sum_l = 0;
+    for (int r = 0; r < win_; ++r) {
+      const uchar* pl = il.ptr<uchar>(y - hw_ + r) + xl - hw_;
+      const uchar* pr = ir.ptr<uchar>(y - hw_ + r) + xr0 - L_ - hw_;
+      for (int c = 0; c < win_; ++c) {
+        left_[static_cast<std::size_t>(r * win_ + c)] = pl[c];
+        sum_l += pl[c];
+      }
+      for (int c = 0; c < strip_; ++c) right_[static_cast<std::size_t>(r * strip_ + c)] = pr[c];
+    }
+    for (int c = 0; c < strip_; ++c) {
+      int s = 0;
+      for (int r = 0; r < win_; ++r) s += right_[static_cast<std::size_t>(r * strip_ + c)];
+      colsum_[static_cast<std::size_t>(c)] = s;
+    }
+    const int n = win_ * win_;
+    int sum_r = 0;
+    for (int c = 0; c < win_; ++c) sum_r += colsum_[static_cast<std::size_t>(c)];
+    for (int k = 0; k <= 2 * L_; ++k) {
+      if (k > 0) sum_r += colsum_[static_cast<std::size_t>(k + win_ - 1)] - colsum_[static_cast<std::size_t>(k - 1)];
+      const int diff = sum_l - sum_r;
+      const int offset = (diff + (diff >= 0 ? n / 2 : -n / 2)) / n;
+      int total = 0;
+      for (int r = 0; r < win_; ++r) {
+        const int* pl = left_.data() + r * win_;
+        const int* pr = right_.data() + r * strip_ + k;
+        for (int c = 0; c < win_; ++c) total += std::abs(pl[c] - pr[c] - offset);
+      }
+      sad[k] = total;
     }
   }
-  const int n = (2 * hw + 1) * (2 * hw + 1);
-  const int offset = (sum_l - sum_r + (sum_l >= sum_r ? n / 2 : -n / 2)) / n;
-  int sad = 0;
-  for (int dy = -hw; dy <= hw; ++dy) {
-    const uchar* pl = left.ptr<uchar>(y + dy) + xl;
-    const uchar* pr = right.ptr<uchar>(y + dy) + xr;
-    for (int dx = -hw; dx <= hw; ++dx) sad += std::abs(pl[dx] - pr[dx] - offset);
-  }
-  return sad;
-}
+
+ private:
+  int hw_, L_, win_, strip_;
+  std::vector<int> left_, right_, colsum_;
+};
 
 }  // namespace
 
@@ -64,18 +89,30 @@ StereoPointMatches match_stereo_points(const features::PointFeatures& left,
   const double z_min = o.min_depth > 0 ? o.min_depth : o.baseline;
   const float max_disparity = static_cast<float>(o.bf / z_min);
 
-  // Row index: each right keypoint is listed in every row its band covers.
-  std::vector<std::vector<int>> by_row(static_cast<std::size_t>(rows));
-  for (std::size_t i = 0; i < right.keypoints.size(); ++i) {
-    const auto& k = right.keypoints[i];
+  // Row index (compressed rows): each right keypoint is listed in every row its band covers.
+  std::vector<int> row_start(static_cast<std::size_t>(rows) + 1, 0), row_items;
+  auto band = [&](const cv::KeyPoint& k) {
     const float r = o.row_band * static_cast<float>(right.pyramid.scale(k.octave));
-    const int y0 = std::max(0, static_cast<int>(std::floor(k.pt.y - r)));
-    const int y1 = std::min(rows - 1, static_cast<int>(std::ceil(k.pt.y + r)));
-    for (int y = y0; y <= y1; ++y) by_row[static_cast<std::size_t>(y)].push_back(static_cast<int>(i));
+    return std::pair<int, int>(std::max(0, static_cast<int>(std::floor(k.pt.y - r))),
+                               std::min(rows - 1, static_cast<int>(std::ceil(k.pt.y + r))));
+  };
+  for (const auto& k : right.keypoints) {
+    const auto [y0, y1] = band(k);
+    for (int y = y0; y <= y1; ++y) ++row_start[static_cast<std::size_t>(y) + 1];
+  }
+  for (int y = 0; y < rows; ++y) row_start[static_cast<std::size_t>(y) + 1] += row_start[static_cast<std::size_t>(y)];
+  row_items.resize(static_cast<std::size_t>(row_start.back()));
+  {
+    std::vector<int> fill(row_start.begin(), row_start.end() - 1);
+    for (std::size_t i = 0; i < right.keypoints.size(); ++i) {
+      const auto [y0, y1] = band(right.keypoints[i]);
+      for (int y = y0; y <= y1; ++y) row_items[static_cast<std::size_t>(fill[static_cast<std::size_t>(y)]++)] = static_cast<int>(i);
+    }
   }
 
   const int hw = o.sad_half_window, L = o.sad_search;
   std::vector<int> sad(static_cast<std::size_t>(2 * L + 1));
+  SadCurve curve(hw, L);
   std::vector<std::pair<int, std::size_t>> sad_of_match;  // (SAD, left index)
   sad_of_match.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -85,7 +122,8 @@ StereoPointMatches match_stereo_points(const features::PointFeatures& left,
     const float min_u = kl.pt.x - max_disparity, max_u = kl.pt.x;
     const uint8_t* dl = left.descriptors.ptr<uint8_t>(static_cast<int>(i));
     int best_dist = 257, best = -1;
-    for (int j : by_row[static_cast<std::size_t>(yl)]) {
+    for (int r = row_start[static_cast<std::size_t>(yl)]; r < row_start[static_cast<std::size_t>(yl) + 1]; ++r) {
+      const int j = row_items[static_cast<std::size_t>(r)];
       const auto& kr = right.keypoints[static_cast<std::size_t>(j)];
       if (kr.octave < kl.octave - 1 || kr.octave > kl.octave + 1) continue;
       if (kr.pt.x < min_u || kr.pt.x > max_u) continue;
@@ -116,12 +154,11 @@ StereoPointMatches match_stereo_points(const features::PointFeatures& left,
       ++out.rejected.window;
       continue;
     }
+    curve.compute(il, xl, y, ir, xr0, sad.data());
     int best_sad = INT_MAX, best_inc = 0;
     for (int inc = -L; inc <= L; ++inc) {
-      const int s = zero_mean_sad(il, xl, y, ir, xr0 + inc, hw);
-      sad[static_cast<std::size_t>(inc + L)] = s;
-      if (s < best_sad) {
-        best_sad = s;
+      if (sad[static_cast<std::size_t>(inc + L)] < best_sad) {
+        best_sad = sad[static_cast<std::size_t>(inc + L)];
         best_inc = inc;
       }
     }
