@@ -1,6 +1,8 @@
 #include "plslam/features/ssc.h"
 
 #include <algorithm>
+#include <array>
+#include <stdexcept>
 #include <cmath>
 #include <numeric>
 
@@ -66,28 +68,76 @@ std::vector<int> order_by_response(const std::vector<cv::KeyPoint>& keypoints) {
 
 namespace {
 
-// One greedy covering pass at width w over candidates sorted strongest first. Stops once
-// `limit` points are kept (the caller only needs to know it overshot). Returns the kept count.
+// Candidates in visiting order (strongest first): original index and integer pixel position
+// packed as y << 16 | x. The covering works on whole pixels (FAST corners are whole pixels).
+struct SortedCandidates {
+  std::vector<int> index;
+  std::vector<uint32_t> packed;
+};
+
+SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv::Size size) {
+  const int k = static_cast<int>(keypoints.size());
+  SortedCandidates s;
+  s.index.resize(static_cast<std::size_t>(k));
+  s.packed.resize(static_cast<std::size_t>(k));
+  auto pack = [&](const cv::KeyPoint& kp) {
+    const auto x = static_cast<uint32_t>(std::clamp(static_cast<int>(kp.pt.x), 0, size.width - 1));
+    const auto y = static_cast<uint32_t>(std::clamp(static_cast<int>(kp.pt.y), 0, size.height - 1));
+    return y << 16 | x;
+  };
+  // Counting sort on integer scores (FAST's), descending and stable, in two sequential passes.
+  constexpr int kBins = 1024;
+  std::array<int, kBins + 1> start{};
+  bool integer_scores = true;
+  for (const auto& kp : keypoints) {
+    const float r = kp.response;
+    if (!(r >= 0.f && r < kBins && r == std::floor(r))) {
+      integer_scores = false;
+      break;
+    }
+    ++start[static_cast<std::size_t>(kBins - static_cast<int>(r))];
+  }
+  if (integer_scores) {
+    for (int i = 0; i < kBins; ++i) start[static_cast<std::size_t>(i) + 1] += start[static_cast<std::size_t>(i)];
+    for (int i = 0; i < k; ++i) {
+      const auto& kp = keypoints[static_cast<std::size_t>(i)];
+      const auto pos = static_cast<std::size_t>(start[static_cast<std::size_t>(kBins - 1 - static_cast<int>(kp.response))]++);
+      s.index[pos] = i;
+      s.packed[pos] = pack(kp);
+    }
+    return s;
+  }
+  s.index = order_by_response(keypoints);
+  for (int i = 0; i < k; ++i) s.packed[static_cast<std::size_t>(i)] = pack(keypoints[static_cast<std::size_t>(s.index[static_cast<std::size_t>(i)])]);
+  return s;
+}
+
+// One greedy covering pass at width w over the sorted candidates. Stops once `limit` points are
+// kept (the caller then only needs to know it overshot). Returns the kept count.
 class Coverer {
  public:
-  Coverer(const std::vector<float>& xs, const std::vector<float>& ys, cv::Size size)
-      : xs_(xs), ys_(ys), size_(size) {}
+  Coverer(const std::vector<uint32_t>& packed, cv::Size size) : packed_(packed), size_(size) {}
 
   int run(double w, int limit, std::vector<int>& kept_sorted_pos) {
     const double c = w / 2.0;
-    const float inv_c = static_cast<float>(1.0 / c);
     const int cols = static_cast<int>(std::ceil(size_.width / c)) + 1;
     const int rows = static_cast<int>(std::ceil(size_.height / c)) + 1;
     // Two margin cells on each side so covering a 5x5 block needs no bounds checks.
     const int stride = cols + 4;
     grid_.assign(static_cast<std::size_t>(stride) * static_cast<std::size_t>(rows + 4), 0);
+    // Pixel -> cell lookups: the pass then needs no division or float conversion.
+    col_of_x_.resize(static_cast<std::size_t>(size_.width));
+    row_of_y_.resize(static_cast<std::size_t>(size_.height));
+    for (int x = 0; x < size_.width; ++x) col_of_x_[static_cast<std::size_t>(x)] = static_cast<int>(x / c) + 2;
+    for (int y = 0; y < size_.height; ++y) row_of_y_[static_cast<std::size_t>(y)] = (static_cast<int>(y / c) + 2) * stride;
     kept_sorted_pos.clear();
-    const int n = static_cast<int>(xs_.size());
+    const int n = static_cast<int>(packed_.size());
     uint8_t* g = grid_.data();
+    const uint32_t* p = packed_.data();
+    const int* cx = col_of_x_.data();
+    const int* ry = row_of_y_.data();
     for (int i = 0; i < n; ++i) {
-      const int cx = std::clamp(static_cast<int>(xs_[static_cast<std::size_t>(i)] * inv_c), 0, cols - 1) + 2;
-      const int cy = std::clamp(static_cast<int>(ys_[static_cast<std::size_t>(i)] * inv_c), 0, rows - 1) + 2;
-      uint8_t* cell = g + cy * stride + cx;
+      uint8_t* cell = g + ry[p[i] >> 16] + cx[p[i] & 0xFFFFu];
       if (*cell) continue;
       kept_sorted_pos.push_back(i);
       if (static_cast<int>(kept_sorted_pos.size()) >= limit) break;
@@ -100,10 +150,10 @@ class Coverer {
   }
 
  private:
-  const std::vector<float>& xs_;
-  const std::vector<float>& ys_;
+  const std::vector<uint32_t>& packed_;
   cv::Size size_;
   std::vector<uint8_t> grid_;
+  std::vector<int> col_of_x_, row_of_y_;
 };
 
 }  // namespace
@@ -112,27 +162,21 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
                      double tolerance_fraction) {
   SscResult result;
   const int k = static_cast<int>(keypoints.size());
-  if (target <= 0 || k == 0) return result;
-  const std::vector<int> order = order_by_response(keypoints);
+  if (target <= 0 || k == 0 || size.width < 1 || size.height < 1) return result;
+  if (size.width > 65535 || size.height > 65535) throw std::invalid_argument("ssc_select: image too large");
   if (k <= target) {
-    result.kept = order;
+    result.kept = order_by_response(keypoints);
     return result;
   }
-  // Positions in visiting order, contiguous: the passes below are memory-bound.
-  std::vector<float> xs(static_cast<std::size_t>(k)), ys(static_cast<std::size_t>(k));
-  for (int i = 0; i < k; ++i) {
-    const auto& p = keypoints[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])].pt;
-    xs[static_cast<std::size_t>(i)] = std::max(p.x, 0.f);
-    ys[static_cast<std::size_t>(i)] = std::max(p.y, 0.f);
-  }
+  const SortedCandidates sorted = sort_candidates(keypoints, size);
   const int tolerance = static_cast<int>(std::floor(tolerance_fraction * target));
   const SscBounds bounds = ssc_width_bounds(k, target, size);
 
-  Coverer cover(xs, ys, size);
+  Coverer cover(sorted.packed, size);
   std::vector<int> pass, best;
   double best_width = 0;
   // Integer widths, as in Bailo et al.: the count changes in steps anyway, and the search
-  // ends after log2(w_high) passes.
+  // ends after about log2(w_high) passes.
   int low = static_cast<int>(std::floor(bounds.low));
   int high = static_cast<int>(std::ceil(bounds.high));
   bool done = false;
@@ -155,15 +199,15 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
     }
   }
   if (!done && best.empty()) {
-    // Only possible with non-integer or duplicate positions: fall back to the narrowest cover.
-    cover.run(std::max(1, static_cast<int>(std::floor(bounds.low))), target, best);
+    // Only possible with duplicate positions: fall back to the narrowest cover.
     best_width = std::max(1.0, std::floor(bounds.low));
+    cover.run(best_width, target, best);
     ++result.iterations;
   }
   if (static_cast<int>(best.size()) > target + tolerance) best.resize(static_cast<std::size_t>(target));
   result.width = best_width;
   result.kept.reserve(best.size());
-  for (int pos : best) result.kept.push_back(order[static_cast<std::size_t>(pos)]);
+  for (int pos : best) result.kept.push_back(sorted.index[static_cast<std::size_t>(pos)]);
   return result;
 }
 
