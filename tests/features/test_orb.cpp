@@ -10,6 +10,7 @@
 
 #include "features/points_synthetic.h"
 #include "plslam/core/error.h"
+#include "plslam/features/fast_gaussian.h"
 #include "plslam/features/orb_descriptor.h"
 #include "plslam/features/orb_extractor.h"
 #include "support/test_support.h"
@@ -38,6 +39,21 @@ TEST(ImagePyramid, LevelSizesCoordinateMapsAndBorder) {
   }
   // Level 1 is a bilinear shrink of level 0: a smooth region's mean is preserved.
   EXPECT_NEAR(cv::mean(p.level(1))[0], cv::mean(img)[0], 1.0);
+}
+
+TEST(FastGaussian, MatchesOpenCvGaussianBlurWithinTwoGreyLevels) {
+  const cv::Mat img = test::points_texture(cv::Size(300, 200), 3);
+  const cv::Rect rect(3, 3, 294, 194);
+  cv::Mat ours, ref;
+  gaussian_blur_7x7(img, rect, ours);
+  cv::GaussianBlur(img, ref, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
+  ASSERT_EQ(ours.size(), rect.size());
+  EXPECT_LE(cv::norm(ours, ref(rect), cv::NORM_INF), 2.0);
+  // A constant image stays constant (the fixed-point kernel sums to exactly 1).
+  const cv::Mat flat(50, 50, CV_8U, cv::Scalar(173));
+  gaussian_blur_7x7(flat, cv::Rect(3, 3, 44, 44), ours);
+  EXPECT_EQ(cv::norm(ours, cv::Mat(44, 44, CV_8U, cv::Scalar(173)), cv::NORM_INF), 0.0);
+  EXPECT_THROW(gaussian_blur_7x7(flat, cv::Rect(2, 3, 44, 44), ours), std::invalid_argument);
 }
 
 TEST(OrbDescriptor, PatternIsDeterministicBoundedAndNonDegenerate) {

@@ -112,6 +112,23 @@ TEST(Ssc, DeterministicAndIndependentOfInputOrder) {
   EXPECT_EQ(mapped, a.kept);
 }
 
+TEST(Ssc, WidthHintShortensTheSearchAndKeepsTheGuarantees) {
+  const cv::Size size(752, 480);
+  const auto kps = random_keypoints(12000, size, 21u);
+  const SscResult plain = ssc_select(kps, 400, size);
+  ASSERT_GT(plain.iterations, 2);
+  const SscResult hinted = ssc_select(kps, 400, size, 0.001, plain.width);
+  EXPECT_LE(hinted.iterations, 2);
+  EXPECT_EQ(hinted.width, plain.width);
+  EXPECT_EQ(hinted.kept, plain.kept);
+  // A bad hint costs passes but not correctness.
+  for (const double bad : {2.0, 500.0, plain.width + 7}) {
+    const SscResult r = ssc_select(kps, 400, size, 0.001, bad);
+    EXPECT_EQ(r.kept.size(), 400u);
+    EXPECT_GT(min_max_norm_distance(kps, r.kept), r.width);
+  }
+}
+
 TEST(Ssc, FewCandidatesAreAllKept) {
   const cv::Size size(200, 100);
   const auto kps = random_keypoints(30, size, 2u);

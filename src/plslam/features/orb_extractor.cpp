@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "plslam/core/error.h"
+#include "plslam/features/fast_gaussian.h"
 #include "plslam/features/orb_descriptor.h"
 #include "plslam/features/quadtree.h"
 #include "plslam/features/ssc.h"
@@ -147,13 +148,23 @@ std::vector<int> OrbExtractor::level_targets(const PyramidCandidates& candidates
 PyramidCandidates OrbExtractor::distribute(const PyramidCandidates& candidates, Distribution method) const {
   const std::vector<int> targets = level_targets(candidates);
   PyramidCandidates out(candidates.size());
-  for (std::size_t l = 0; l < candidates.size(); ++l) {
+  // From the smallest level up: its search is cheap, and its width is a good first guess for the
+  // next level (the per-level target follows the area, so the width in level pixels barely
+  // changes).
+  double width_hint = 0;
+  for (std::size_t r = 0; r < candidates.size(); ++r) {
+    const std::size_t l = candidates.size() - 1 - r;
     const auto& lc = candidates[l];
     out[l].offset = lc.offset;
     out[l].region = lc.region;
-    const std::vector<int> kept = method == Distribution::kSsc
-                                      ? ssc_select(lc.keypoints, targets[l], lc.region, options_.ssc_tolerance).kept
-                                      : quadtree_select(lc.keypoints, targets[l], lc.region);
+    std::vector<int> kept;
+    if (method == Distribution::kSsc) {
+      SscResult res = ssc_select(lc.keypoints, targets[l], lc.region, options_.ssc_tolerance, width_hint);
+      if (res.width > 0) width_hint = res.width;
+      kept = std::move(res.kept);
+    } else {
+      kept = quadtree_select(lc.keypoints, targets[l], lc.region);
+    }
     out[l].keypoints.reserve(kept.size());
     for (int i : kept) out[l].keypoints.push_back(lc.keypoints[static_cast<std::size_t>(i)]);
   }
@@ -171,13 +182,14 @@ void OrbExtractor::describe(const ImagePyramid& pyramid, const PyramidCandidates
   // Blur only the level plus the band BRIEF samples can reach; the pixels around that band in
   // the padded buffer serve as the filter's border.
   const int expand = std::min(kPyramidBorder - kBlurRadius, std::max(0, kBriefReach - options_.edge_margin));
+  static_assert(kBlurRadius == 3, "gaussian_blur_7x7 reads 3 pixels around its rectangle");
   for (int l = 0; l < pyramid.levels() && l < static_cast<int>(kept.size()); ++l) {
     const auto& lc = kept[static_cast<std::size_t>(l)];
     if (lc.keypoints.empty()) continue;
     const cv::Mat& level = pyramid.level(l);
     const int b = pyramid.border();
     const cv::Rect blur_rect(b - expand, b - expand, level.cols + 2 * expand, level.rows + 2 * expand);
-    cv::GaussianBlur(pyramid.padded(l)(blur_rect), blurred, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
+    gaussian_blur_7x7(pyramid.padded(l), blur_rect, blurred);
     const float size = static_cast<float>(31.0 * pyramid.scale(l));
     for (const auto& k : lc.keypoints) {
       const int x = static_cast<int>(k.pt.x) + lc.offset.x;

@@ -159,7 +159,7 @@ class Coverer {
 }  // namespace
 
 SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
-                     double tolerance_fraction) {
+                     double tolerance_fraction, double width_hint) {
   SscResult result;
   const int k = static_cast<int>(keypoints.size());
   if (target <= 0 || k == 0 || size.width < 1 || size.height < 1) return result;
@@ -180,24 +180,33 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
   int low = static_cast<int>(std::floor(bounds.low));
   int high = static_cast<int>(std::ceil(bounds.high));
   bool done = false;
-  while (low <= high) {
-    const int w = low + (high - low) / 2;
+  // One probe: true when the search is over (count within tolerance).
+  auto probe = [&](int w) {
     const int count = cover.run(w, target + tolerance + 1, pass);
     ++result.iterations;
     if (std::abs(count - target) <= tolerance) {
       best.swap(pass);
       best_width = w;
-      done = true;
-      break;
+      return true;
     }
     if (count > target) {
       best.swap(pass);  // feasible: remember it, then try wider
       best_width = w;
-      low = w + 1;
+      low = std::max(low, w + 1);
     } else {
-      high = w - 1;
+      high = std::min(high, w - 1);
     }
+    return false;
+  };
+  const int hint = static_cast<int>(std::lround(width_hint));
+  if (hint >= low && hint <= high) {
+    done = probe(hint);
+    // Feasible at the hint: the next width decides whether the hint was the widest.
+    if (!done && low == hint + 1 && low <= high) done = probe(hint + 1);
+    // Infeasible at the hint: try just below it.
+    else if (!done && high == hint - 1 && low <= high) done = probe(hint - 1);
   }
+  while (!done && low <= high) done = probe(low + (high - low) / 2);
   if (!done && best.empty()) {
     // Only possible with duplicate positions: fall back to the narrowest cover.
     best_width = std::max(1.0, std::floor(bounds.low));
