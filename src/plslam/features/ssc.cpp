@@ -46,7 +46,7 @@ std::vector<int> order_by_response(const std::vector<cv::KeyPoint>& keypoints) {
   std::vector<int> order(static_cast<std::size_t>(n));
   constexpr int kBins = 1024;
   const bool small_integers = std::all_of(keypoints.begin(), keypoints.end(), [](const cv::KeyPoint& k) {
-    return k.response >= 0.f && k.response < kBins && k.response == std::floor(k.response);
+    return k.response >= 0.f && k.response < kBins && static_cast<float>(static_cast<int>(k.response)) == k.response;
   });
   if (small_integers) {
     // Counting sort, descending, stable: O(K) instead of O(K log K).
@@ -86,12 +86,13 @@ SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv:
     return y << 16 | x;
   };
   // Counting sort on integer scores (FAST's), descending and stable, in two sequential passes.
-  constexpr int kBins = 1024;
+  constexpr int kBins = 256;  // FAST scores are below 256
   std::array<int, kBins + 1> start{};
   bool integer_scores = true;
   for (const auto& kp : keypoints) {
     const float r = kp.response;
-    if (!(r >= 0.f && r < kBins && r == std::floor(r))) {
+    // Integer test by conversion: std::floor is a library call without SSE4.1.
+    if (!(r >= 0.f && r < kBins && static_cast<float>(static_cast<int>(r)) == r)) {
       integer_scores = false;
       break;
     }
@@ -118,18 +119,17 @@ class Coverer {
  public:
   Coverer(const std::vector<uint32_t>& packed, cv::Size size) : packed_(packed), size_(size) {}
 
-  int run(double w, int limit, std::vector<int>& kept_sorted_pos) {
-    const double c = w / 2.0;
-    const int cols = static_cast<int>(std::ceil(size_.width / c)) + 1;
-    const int rows = static_cast<int>(std::ceil(size_.height / c)) + 1;
+  int run(int w, int limit, std::vector<int>& kept_sorted_pos) {
+    // Cells of side c = w/2: the cell of pixel x is floor(2x / w).
+    const int cols = (2 * (size_.width - 1)) / w + 1;
+    const int rows = (2 * (size_.height - 1)) / w + 1;
     // Two margin cells on each side so covering a 5x5 block needs no bounds checks.
     const int stride = cols + 4;
     grid_.assign(static_cast<std::size_t>(stride) * static_cast<std::size_t>(rows + 4), 0);
-    // Pixel -> cell lookups: the pass then needs no division or float conversion.
-    col_of_x_.resize(static_cast<std::size_t>(size_.width));
-    row_of_y_.resize(static_cast<std::size_t>(size_.height));
-    for (int x = 0; x < size_.width; ++x) col_of_x_[static_cast<std::size_t>(x)] = static_cast<int>(x / c) + 2;
-    for (int y = 0; y < size_.height; ++y) row_of_y_[static_cast<std::size_t>(y)] = (static_cast<int>(y / c) + 2) * stride;
+    // Pixel -> cell lookups, filled incrementally (no division per pixel); the pass then needs no
+    // division or float conversion.
+    fill_cells(col_of_x_, size_.width, w, 1);
+    fill_cells(row_of_y_, size_.height, w, stride);
     kept_sorted_pos.clear();
     const int n = static_cast<int>(packed_.size());
     uint8_t* g = grid_.data();
@@ -150,6 +150,20 @@ class Coverer {
   }
 
  private:
+  // table[x] = (floor(2x / w) + 2) * scale for x in [0, n).
+  static void fill_cells(std::vector<int>& table, int n, int w, int scale) {
+    table.resize(static_cast<std::size_t>(n));
+    int q = 0, r = 0;  // 2x = q w + r, 0 <= r < w
+    for (int x = 0; x < n; ++x) {
+      table[static_cast<std::size_t>(x)] = (q + 2) * scale;
+      r += 2;
+      while (r >= w) {
+        r -= w;
+        ++q;
+      }
+    }
+  }
+
   const std::vector<uint32_t>& packed_;
   cv::Size size_;
   std::vector<uint8_t> grid_;
@@ -174,6 +188,8 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
 
   Coverer cover(sorted.packed, size);
   std::vector<int> pass, best;
+  pass.reserve(static_cast<std::size_t>(target + tolerance + 1));
+  best.reserve(static_cast<std::size_t>(target + tolerance + 1));
   double best_width = 0;
   // Integer widths, as in Bailo et al.: the count changes in steps anyway, and the search
   // ends after about log2(w_high) passes.
@@ -209,8 +225,9 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
   while (!done && low <= high) done = probe(low + (high - low) / 2);
   if (!done && best.empty()) {
     // Only possible with duplicate positions: fall back to the narrowest cover.
-    best_width = std::max(1.0, std::floor(bounds.low));
-    cover.run(best_width, target, best);
+    const int w = std::max(1, static_cast<int>(std::floor(bounds.low)));
+    best_width = w;
+    cover.run(w, target, best);
     ++result.iterations;
   }
   if (static_cast<int>(best.size()) > target + tolerance) best.resize(static_cast<std::size_t>(target));
