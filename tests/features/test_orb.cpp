@@ -151,6 +151,23 @@ TEST(OrbExtractor, IniMinModeAndShortLevelsStillFillTheBudget) {
   o.fast_mode = FastMode::kIniMin;
   o.n_features = 1000;
   EXPECT_EQ(OrbExtractor(o).extract(img).keypoints.size(), 1000u);
+  // Strong corners are all kept; weak ones only where a cell has no strong one, so far fewer.
+  {
+    OrbOptions single = o;
+    single.fast_mode = FastMode::kSingle;
+    single.fast_threshold = o.fast_min_threshold;
+    ImagePyramid pyr;
+    OrbExtractor(single).build_pyramid(img, pyr);
+    const auto all = OrbExtractor(single).detect(pyr)[0].keypoints;
+    const auto mixed = OrbExtractor(o).detect(pyr)[0].keypoints;
+    std::size_t strong = 0;
+    for (const auto& k : all) strong += k.response >= o.fast_ini_threshold;
+    std::size_t mixed_strong = 0;
+    for (const auto& k : mixed) mixed_strong += k.response >= o.fast_ini_threshold;
+    EXPECT_EQ(mixed_strong, strong);
+    EXPECT_LT(mixed.size(), all.size());
+    EXPECT_GE(mixed.size(), strong);
+  }
   // A budget no level can meet alone: deficits move to other levels, and when every candidate is
   // used the extractor returns all of them.
   const OrbExtractor ex(o);
