@@ -60,21 +60,38 @@ const std::array<std::array<int8_t, 4>, 256>& brief_pattern() {
 }
 
 float intensity_centroid_angle(const cv::Mat& image, int x, int y) {
-  static const auto umax = make_umax();
-  const uchar* center = image.ptr<uchar>(y) + x;
-  const int step = static_cast<int>(image.step1());
-  int m10 = 0, m01 = 0;
-  for (int u = -kOrbPatchRadius; u <= kOrbPatchRadius; ++u) m10 += u * center[u];
-  // Rows v and -v together: their sum feeds m10, their difference m01.
-  for (int v = 1; v <= kOrbPatchRadius; ++v) {
-    int v_sum = 0;
-    const int d = umax[static_cast<std::size_t>(v)];
-    for (int u = -d; u <= d; ++u) {
-      const int below = center[u + v * step], above = center[u - v * step];
-      v_sum += below - above;
-      m10 += u * (below + above);
+  // Every row of the disc as 32 weights over u = -15..16 (zero outside the disc), so each row is
+  // one fixed-length multiply-accumulate the compiler vectorises.
+  struct Disc {
+    alignas(16) int16_t u_weight[2 * kOrbPatchRadius + 1][32];
+    alignas(16) int16_t inside[2 * kOrbPatchRadius + 1][32];
+  };
+  static const Disc disc = [] {
+    Disc d{};
+    const auto umax = make_umax();
+    for (int v = -kOrbPatchRadius; v <= kOrbPatchRadius; ++v) {
+      const int half = umax[static_cast<std::size_t>(std::abs(v))];
+      for (int k = 0; k < 32; ++k) {
+        const int u = k - kOrbPatchRadius;
+        const bool in = std::abs(u) <= half;
+        d.u_weight[v + kOrbPatchRadius][k] = static_cast<int16_t>(in ? u : 0);
+        d.inside[v + kOrbPatchRadius][k] = static_cast<int16_t>(in ? 1 : 0);
+      }
     }
-    m01 += v * v_sum;
+    return d;
+  }();
+  const int step = static_cast<int>(image.step1());
+  const uchar* top_left = image.ptr<uchar>(y) + x - kOrbPatchRadius;
+  int m10 = 0, m01 = 0;
+  for (int r = 0; r <= 2 * kOrbPatchRadius; ++r) {
+    const uchar* row = top_left + (r - kOrbPatchRadius) * step;
+    int su = 0, s1 = 0;
+    for (int k = 0; k < 32; ++k) {
+      su += disc.u_weight[r][k] * row[k];
+      s1 += disc.inside[r][k] * row[k];
+    }
+    m10 += su;
+    m01 += (r - kOrbPatchRadius) * s1;
   }
   return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
 }

@@ -20,7 +20,8 @@ inline constexpr int kBriefPatternHalfExtent = 13;
 const std::array<std::array<int8_t, 4>, 256>& brief_pattern();
 
 // Angle in degrees [0, 360) of the intensity centroid of the radius-15 disc around (x, y), in
-// image axes (x right, y down). (x, y) must be at least 15 px inside `image`'s allocation.
+// image axes (x right, y down). Reads rows y-15..y+15 and columns x-15..x+16 (one spare column
+// for a fixed-width loop), which must lie inside `image`'s allocation.
 float intensity_centroid_angle(const cv::Mat& image, int x, int y);
 
 // Writes the 32-byte descriptor of the point (x, y) with orientation `angle_deg` sampled in
