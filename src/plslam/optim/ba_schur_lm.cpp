@@ -19,6 +19,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 #include <Eigen/Cholesky>
 #include <tbb/blocked_range.h>
@@ -260,12 +261,17 @@ struct Accumulator {
   Eigen::VectorXd g;
   double rho = 0.0;  // sum of rho: twice the cost
   int failures = 0;  // observations behind a camera, or landmark blocks that failed to factor
-  std::vector<Eigen::Matrix<double, 6, 6>> scratch;  // W L^-1 per ref of the current landmark
+  // W L^-1 per ref of the landmark being eliminated (points, lines).
+  std::vector<Eigen::Matrix<double, 6, 3>> Y3;
+  std::vector<Eigen::Matrix<double, 6, 6>> Y6;
 
   Accumulator(int n_cams, int max_group)
       : H(Eigen::MatrixXd::Zero(6 * n_cams, 6 * n_cams)),
         g(Eigen::VectorXd::Zero(6 * n_cams)),
-        scratch(static_cast<std::size_t>(max_group)) {}
+        Y3(static_cast<std::size_t>(max_group)),
+        Y6(static_cast<std::size_t>(max_group)) {}
+  auto& scratch(std::integral_constant<int, 3>) { return Y3; }
+  auto& scratch(std::integral_constant<int, 6>) { return Y6; }
   void add(const Accumulator& o) {
     H += o.H;
     g += o.g;
@@ -475,30 +481,31 @@ void SchurLm::eliminate_slot(Groups<Kind>& G, int i, double lambda, Accumulator&
   }
   const auto& Hinv = G.Hinv[si];
   const int b = G.begin[si], e = G.begin[si + 1];
-  // Y_a = W_a L^-1 (kept in the scratch's left N columns), then S -= Y_a W_b' for b >= a.
+  auto& Ys = acc.scratch(std::integral_constant<int, N>());
+  // Y_a = W_a L^-1, then S -= Y_a W_c' for c >= a (upper block triangle), products written
+  // straight into S.
   for (int a = b; a < e; ++a) {
     const ObsRef& ra = G.refs[static_cast<std::size_t>(a)];
     if (ra.cam < 0) continue;
-    auto Y = acc.scratch[static_cast<std::size_t>(a - b)].template leftCols<N>();
+    auto& Y = Ys[static_cast<std::size_t>(a - b)];
     Y.noalias() = G.W[static_cast<std::size_t>(a)] * Hinv;
     acc.g.template segment<6>(6 * ra.cam).noalias() -= Y * G.g[si];
   }
   for (int a = b; a < e; ++a) {
     const int ca = G.refs[static_cast<std::size_t>(a)].cam;
     if (ca < 0) continue;
-    const auto Y = acc.scratch[static_cast<std::size_t>(a - b)].template leftCols<N>();
+    const auto& Ya = Ys[static_cast<std::size_t>(a - b)];
+    const auto& Wa = G.W[static_cast<std::size_t>(a)];
     for (int c = a; c < e; ++c) {
       const int cc = G.refs[static_cast<std::size_t>(c)].cam;
       if (cc < 0) continue;
-      const Matrix6d M = Y * G.W[static_cast<std::size_t>(c)].transpose();
-      if (ca < cc) {
-        acc.H.block<6, 6>(6 * ca, 6 * cc) -= M;
-      } else if (ca > cc) {
-        acc.H.block<6, 6>(6 * cc, 6 * ca) -= M.transpose();
-      } else if (a == c) {
-        acc.H.block<6, 6>(6 * ca, 6 * ca) -= M;
-      } else {  // the same keyframe observes the landmark twice
-        acc.H.block<6, 6>(6 * ca, 6 * ca) -= M + M.transpose();
+      if (ca <= cc) {
+        acc.H.block<6, 6>(6 * ca, 6 * cc).noalias() -= Ya * G.W[static_cast<std::size_t>(c)].transpose();
+      } else {  // (Y_a W_c')' = Y_c W_a' since W L^-1 W' is symmetric
+        acc.H.block<6, 6>(6 * cc, 6 * ca).noalias() -= Ys[static_cast<std::size_t>(c - b)] * Wa.transpose();
+      }
+      if (ca == cc && a != c) {  // the same keyframe observes the landmark twice: both orders
+        acc.H.block<6, 6>(6 * ca, 6 * ca).noalias() -= Ys[static_cast<std::size_t>(c - b)] * Wa.transpose();
       }
     }
   }
