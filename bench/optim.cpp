@@ -39,9 +39,11 @@ BENCHMARK(BM_PoseOnly)->Args({1000, 200})->Args({1000, 0})->Args({0, 200})
     ->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
 
 // Local BA at the size. Args: {backend: 0 Schur LM, 1 Ceres DENSE_SCHUR, 2 Ceres
-// SPARSE_SCHUR; second pass with outlier removal (0/1); threads}. CPU time is the whole process'
-// (worker threads included), so threaded variants are not flattered; wall time is also reported
-// but depends on the other jobs sharing the machine.
+// SPARSE_SCHUR; second pass with outlier removal (0/1); threads; forced: 1 px observation noise
+// and no function tolerance, so that exactly 10 LM iterations run (0: exact observations, the
+// solvers stop when converged)}. CPU time is the whole process' (worker threads included), so
+// threaded variants are not flattered; wall time is also reported but depends on the other jobs
+// sharing the machine.
 void BM_BundleAdjustment(benchmark::State& state) {
   const auto cam = test::kitti_like_camera();
   std::mt19937 rng(2);
@@ -50,6 +52,17 @@ void BM_BundleAdjustment(benchmark::State& state) {
   test::perturb(&scene.problem, 0.02, 0.005, 0.02, rng);
   optim::BaOptions opt;
   opt.iterations = 10;
+  if (state.range(3) != 0) {
+    std::normal_distribution<double> noise(0.0, 1.0);
+    for (auto& o : scene.problem.point_observations) {
+      o.measurement += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    }
+    for (auto& o : scene.problem.line_observations) {
+      o.left_line(2) += noise(rng);
+      o.right_line(2) += noise(rng);
+    }
+    opt.function_tolerance = 0.0;
+  }
   opt.backend = state.range(0) == 0 ? optim::BaBackend::kSchurLM : optim::BaBackend::kCeres;
   opt.linear_solver = state.range(0) == 2 ? optim::BaLinearSolver::kSparseSchur
                                           : optim::BaLinearSolver::kDenseSchur;
@@ -72,10 +85,11 @@ void BM_BundleAdjustment(benchmark::State& state) {
   state.counters["lm_iters"] = iterations;  // Ceres counts its iteration 0 too
 }
 BENCHMARK(BM_BundleAdjustment)
-    ->ArgNames({"backend", "second_pass", "threads"})
-    ->Args({0, 0, 1})->Args({1, 0, 1})->Args({2, 0, 1})
-    ->Args({0, 1, 1})->Args({1, 1, 1})
-    ->Args({0, 0, 2})->Args({1, 0, 2})
+    ->ArgNames({"backend", "second_pass", "threads", "forced"})
+    ->Args({0, 0, 1, 0})->Args({1, 0, 1, 0})->Args({2, 0, 1, 0})
+    ->Args({0, 0, 1, 1})->Args({1, 0, 1, 1})
+    ->Args({0, 1, 1, 0})->Args({1, 1, 1, 0})
+    ->Args({0, 0, 2, 0})->Args({1, 0, 2, 0})
     ->UseRealTime()->MeasureProcessCPUTime()
     ->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
 

@@ -87,6 +87,7 @@ BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& 
   so.linear_solver_ordering.reset(ordering);
   so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   so.max_num_iterations = spec.iterations;
+  so.function_tolerance = opt.function_tolerance;
   so.num_threads = opt.num_threads;
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;

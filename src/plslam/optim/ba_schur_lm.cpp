@@ -46,7 +46,6 @@ constexpr double kInitialLambda = 1e-4;
 constexpr double kMinLambda = 1e-12;  // floor: the line gauge stays damped (Ceres: 1e-16)
 constexpr double kMaxLambda = 1e32;
 constexpr double kMinRelativeDecrease = 1e-3;
-constexpr double kFunctionTolerance = 1e-6;
 constexpr double kGradientTolerance = 1e-10;
 constexpr double kParameterTolerance = 1e-8;
 
@@ -684,7 +683,7 @@ BaPassSummary SchurLm::run() {
     const double decrease = 0.5 * (rho_ - rho_new);
     const double model = model_decrease(lambda);
     const double ratio = decrease / model;
-    const bool converged = std::isfinite(rho_new) && std::abs(decrease) <= kFunctionTolerance * 0.5 * rho_;
+    const bool converged = std::isfinite(rho_new) && std::abs(decrease) <= opt_.function_tolerance * 0.5 * rho_;
     if (std::isfinite(rho_new) && model > 0.0 && ratio > kMinRelativeDecrease) {
       apply(std::move(poses));
       swap_in_next();
