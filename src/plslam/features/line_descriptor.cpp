@@ -1,0 +1,139 @@
+#include "plslam/features/line_descriptor.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <utility>
+
+namespace plslam::features {
+
+namespace {
+
+// Band pairs by increasing separation: nearby bands see nearly the same surface, so their
+// comparisons are the most repeatable bits.
+std::vector<std::pair<int, int>> band_pairs(int m) {
+  std::vector<std::pair<int, int>> p;
+  for (int sep = 1; sep < m; ++sep)
+    for (int i = 0; i + sep < m; ++i) p.emplace_back(i, i + sep);
+  return p;
+}
+
+// Band descriptors (m x 8: mean of 4 row sums, std of 4 row sums) for one segment.
+void band_descriptors(const LineGradient& g, const LineSegment& s, const LbdOptions& o, float* bd) {
+  const int m = o.bands, w = o.band_width, R = m * w;
+  const int W = g.gx.cols, H = g.gx.rows;
+  const cv::Point2f a = g.to_working(s.start), b = g.to_working(s.end);
+  cv::Point2f d = b - a;
+  const float len = static_cast<float>(cv::norm(d));
+  d = len > 0 ? d / len : cv::Point2f(1, 0);
+  const cv::Point2f n(-d.y, d.x);  // towards the bright side
+  const int K = std::clamp(static_cast<int>(len) + 1, 2, o.max_samples_along);
+  const cv::Point2f step = d * (len / (K - 1));
+  const float sigma_g = 0.5f * (R - 1), sigma_l = static_cast<float>(w);
+
+  // Row sums of (d_perp+, d_perp-, d_par+, d_par-), globally weighted, per sample.
+  std::vector<float> rows(static_cast<std::size_t>(R) * 4, 0.f);
+  for (int r = 0; r < R; ++r) {
+    const float off = r - 0.5f * (R - 1);
+    const float wg = std::exp(-off * off / (2 * sigma_g * sigma_g)) / K;
+    cv::Point2f p = a + n * off;
+    float s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    for (int k = 0; k < K; ++k, p += step) {
+      const int x = std::clamp(cvRound(p.x), 0, W - 1), y = std::clamp(cvRound(p.y), 0, H - 1);
+      const float gx = g.gx.ptr<short>(y)[x], gy = g.gy.ptr<short>(y)[x];
+      const float dp = gx * n.x + gy * n.y, dl = gx * d.x + gy * d.y;
+      (dp > 0 ? s0 : s1) += std::fabs(dp);
+      (dl > 0 ? s2 : s3) += std::fabs(dl);
+    }
+    float* row = &rows[static_cast<std::size_t>(r) * 4];
+    row[0] = s0 * wg;
+    row[1] = s1 * wg;
+    row[2] = s2 * wg;
+    row[3] = s3 * wg;
+  }
+  for (int j = 0; j < m; ++j) {
+    const float centre = j * w + 0.5f * (w - 1);
+    const int r0 = std::max(0, (j - 1) * w), r1 = std::min(R, (j + 2) * w);
+    double sw = 0, mean[4] = {0, 0, 0, 0}, sq[4] = {0, 0, 0, 0};
+    for (int r = r0; r < r1; ++r) {
+      const float dr = r - centre;
+      const double wl = std::exp(-dr * dr / (2 * sigma_l * sigma_l));
+      sw += wl;
+      for (int c = 0; c < 4; ++c) {
+        const double v = rows[static_cast<std::size_t>(r) * 4 + c];
+        mean[c] += wl * v;
+        sq[c] += wl * v * v;
+      }
+    }
+    for (int c = 0; c < 4; ++c) {
+      const double mu = mean[c] / sw;
+      bd[j * 8 + c] = static_cast<float>(mu);
+      bd[j * 8 + 4 + c] = static_cast<float>(std::sqrt(std::max(0.0, sq[c] / sw - mu * mu)));
+    }
+  }
+  // Normalise the mean and std parts separately, clamp large entries, renormalise (as LBD does
+  // against non-linear illumination).
+  for (int part = 0; part < 2; ++part) {
+    for (int pass = 0; pass < 2; ++pass) {
+      double nn = 0;
+      for (int j = 0; j < m; ++j)
+        for (int c = 0; c < 4; ++c) nn += double(bd[j * 8 + part * 4 + c]) * bd[j * 8 + part * 4 + c];
+      const float inv = nn > 0 ? static_cast<float>(1.0 / std::sqrt(nn)) : 0.f;
+      for (int j = 0; j < m; ++j)
+        for (int c = 0; c < 4; ++c) {
+          float& v = bd[j * 8 + part * 4 + c];
+          v *= inv;
+          if (pass == 0) v = std::min(v, 0.4f);
+        }
+    }
+  }
+}
+
+void check(const LineGradient& g, const LbdOptions& o) {
+  if (g.gx.empty() || g.gx.type() != CV_16S) throw std::invalid_argument("describe_lines: empty gradient");
+  if (o.bands < 2 || o.band_width < 1 || o.max_samples_along < 2)
+    throw std::invalid_argument("describe_lines: bad LBD options");
+}
+
+}  // namespace
+
+cv::Mat describe_lines_float(const LineGradient& g, const std::vector<LineSegment>& segs, const LbdOptions& o) {
+  check(g, o);
+  cv::Mat out(static_cast<int>(segs.size()), o.bands * 8, CV_32F);
+  for (int i = 0; i < out.rows; ++i) band_descriptors(g, segs[i], o, out.ptr<float>(i));
+  return out;
+}
+
+cv::Mat describe_lines(const LineGradient& g, const std::vector<LineSegment>& segs, const LbdOptions& o) {
+  check(g, o);
+  const auto pairs = band_pairs(o.bands);
+  if (pairs.size() * 8 < kLbdBytes * 8) throw std::invalid_argument("describe_lines: too few bands for 256 bits");
+  cv::Mat out(static_cast<int>(segs.size()), kLbdBytes, CV_8U, cv::Scalar(0));
+  std::vector<float> bd(static_cast<std::size_t>(o.bands) * 8);
+  for (int i = 0; i < out.rows; ++i) {
+    band_descriptors(g, segs[i], o, bd.data());
+    uint8_t* bits = out.ptr<uint8_t>(i);
+    for (int p = 0; p < kLbdBytes; ++p) {
+      const auto [bi, bj] = pairs[p];
+      uint8_t byte = 0;
+      for (int c = 0; c < 8; ++c) byte |= static_cast<uint8_t>((bd[bi * 8 + c] > bd[bj * 8 + c]) << c);
+      bits[p] = byte;
+    }
+  }
+  return out;
+}
+
+int hamming256(const uint8_t* a, const uint8_t* b) {
+  int d = 0;
+  for (int i = 0; i < kLbdBytes; i += 8) {
+    uint64_t x, y;
+    std::memcpy(&x, a + i, 8);
+    std::memcpy(&y, b + i, 8);
+    d += std::popcount(x ^ y);
+  }
+  return d;
+}
+
+}  // namespace plslam::features

@@ -1,0 +1,120 @@
+#include "plslam/features/line_merger.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace plslam::features {
+
+MergeFrame MergeFrame::of(cv::Size s) {
+  MergeFrame f;
+  f.centre = cv::Point2f(0.5f * (s.width - 1), 0.5f * (s.height - 1));
+  f.half_diagonal = 0.5 * std::hypot(s.width, s.height);
+  return f;
+}
+
+bool can_merge(const LineSegment& a, const LineSegment& b, const MergeFrame& f, const LineMergeOptions& o) {
+  const cv::Point2d da = a.end - a.start, db = b.end - b.start;
+  const double la = std::hypot(da.x, da.y), lb = std::hypot(db.x, db.y);
+  if (la <= 0 || lb <= 0) return false;
+  const double cos_ab = (da.x * db.x + da.y * db.y) / (la * lb);
+  if (o.same_polarity && cos_ab <= 0) return false;
+
+  const HoughLine ha = to_hough(a, f.centre), hb = to_hough(b, f.centre);
+  const double dtheta = hough_angle_difference(ha.theta, hb.theta);
+  if (dtheta >= o.max_theta_deg * CV_PI / 180.0) return false;
+  // Across the theta wrap at pi the same line has the opposite rho.
+  const double rho_b = std::fabs(ha.theta - hb.theta) > CV_PI / 2 ? -hb.rho : hb.rho;
+  if (std::fabs(ha.rho - rho_b) >= o.max_rho_fraction * f.half_diagonal) return false;
+
+  if (distance_to_line(a, b.start) > o.max_endpoint_distance_px ||
+      distance_to_line(a, b.end) > o.max_endpoint_distance_px)
+    return false;
+
+  // Interval of b along a's direction, a occupying [0, la].
+  const cv::Point2d ua = da / la;
+  double t1 = ua.dot(cv::Point2d(b.start - a.start)), t2 = ua.dot(cv::Point2d(b.end - a.start));
+  if (t1 > t2) std::swap(t1, t2);
+  const double gap = std::max(t1 - la, -t2);  // positive when disjoint
+  if (gap > o.max_gap_px) return false;
+  const double overlap = std::min(la, t2) - std::max(0.0, t1);
+  return overlap <= o.max_overlap_px;
+}
+
+LineSegment fuse_segments(const LineSegment& a, const LineSegment& b) {
+  const cv::Point2d pts[4] = {a.start, a.end, b.start, b.end};
+  const double wa = std::max(1e-6f, a.length()), wb = std::max(1e-6f, b.length());
+  const double w[4] = {wa, wa, wb, wb};
+  double sw = 0, mx = 0, my = 0;
+  for (int i = 0; i < 4; ++i) {
+    sw += w[i];
+    mx += w[i] * pts[i].x;
+    my += w[i] * pts[i].y;
+  }
+  mx /= sw;
+  my /= sw;
+  double cxx = 0, cxy = 0, cyy = 0;
+  for (int i = 0; i < 4; ++i) {
+    const double dx = pts[i].x - mx, dy = pts[i].y - my;
+    cxx += w[i] * dx * dx;
+    cxy += w[i] * dx * dy;
+    cyy += w[i] * dy * dy;
+  }
+  const double th = 0.5 * std::atan2(2 * cxy, cxx - cyy);
+  cv::Point2d d(std::cos(th), std::sin(th));
+  if (d.dot(cv::Point2d(a.end - a.start)) < 0) d = -d;
+  double tmin = 1e300, tmax = -1e300;
+  for (const auto& p : pts) {
+    const double t = d.dot(p - cv::Point2d(mx, my));
+    tmin = std::min(tmin, t);
+    tmax = std::max(tmax, t);
+  }
+  LineSegment s;
+  s.start = cv::Point2f(static_cast<float>(mx + tmin * d.x), static_cast<float>(my + tmin * d.y));
+  s.end = cv::Point2f(static_cast<float>(mx + tmax * d.x), static_cast<float>(my + tmax * d.y));
+  s.response = s.length();
+  s.fragments = a.fragments + b.fragments;
+  return s;
+}
+
+std::vector<LineSegment> merge_segments(std::vector<LineSegment> segs, cv::Size image_size,
+                                        const LineMergeOptions& o) {
+  const MergeFrame frame = MergeFrame::of(image_size);
+  const double max_dtheta = o.max_theta_deg * CV_PI / 180.0;
+  // Longest first, so each merge uses the most reliable line as the reference.
+  std::sort(segs.begin(), segs.end(), [](const auto& a, const auto& b) { return a.length() > b.length(); });
+  std::vector<double> angle(segs.size());
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    for (std::size_t i = 0; i < segs.size(); ++i) angle[i] = to_hough(segs[i], frame.centre).theta;
+    std::vector<bool> dead(segs.size(), false);
+    for (std::size_t i = 0; i < segs.size(); ++i) {
+      if (dead[i]) continue;
+      for (std::size_t j = i + 1; j < segs.size(); ++j) {
+        // Cheap angle reject before the full test: most pairs differ by far more than 1 degree.
+        if (dead[j] || hough_angle_difference(angle[i], angle[j]) >= max_dtheta) continue;
+        const bool i_longer = segs[i].length() >= segs[j].length();
+        const LineSegment& a = i_longer ? segs[i] : segs[j];
+        const LineSegment& b = i_longer ? segs[j] : segs[i];
+        if (!can_merge(a, b, frame, o)) continue;
+        segs[i] = fuse_segments(a, b);
+        angle[i] = to_hough(segs[i], frame.centre).theta;
+        dead[j] = true;
+        changed = true;
+      }
+    }
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < segs.size(); ++i)
+      if (!dead[i]) segs[k++] = segs[i];
+    segs.resize(k);
+  }
+  for (auto& s : segs) s.response = s.length();
+  return segs;
+}
+
+void keep_best(std::vector<LineSegment>& segs, std::size_t n) {
+  std::sort(segs.begin(), segs.end(), [](const auto& a, const auto& b) { return a.response > b.response; });
+  if (segs.size() > n) segs.resize(n);
+}
+
+}  // namespace plslam::features
