@@ -20,8 +20,33 @@ std::vector<std::pair<int, int>> band_pairs(int m) {
   return p;
 }
 
+// Gaussian weights depend only on the options: global per row (distance to the line) and local
+// per (band, row in the band's 3-band window). Computed once per call, not per line.
+struct LbdWeights {
+  std::vector<float> global;               // R
+  std::vector<std::vector<double>> local;  // m x (rows r0..r1)
+  explicit LbdWeights(const LbdOptions& o) {
+    const int m = o.bands, w = o.band_width, R = m * w;
+    const float sigma_g = 0.5f * (R - 1), sigma_l = static_cast<float>(w);
+    for (int r = 0; r < R; ++r) {
+      const float off = r - 0.5f * (R - 1);
+      global.push_back(std::exp(-off * off / (2 * sigma_g * sigma_g)));
+    }
+    for (int j = 0; j < m; ++j) {
+      const float centre = j * w + 0.5f * (w - 1);
+      std::vector<double> l;
+      for (int r = std::max(0, (j - 1) * w); r < std::min(R, (j + 2) * w); ++r) {
+        const float dr = r - centre;
+        l.push_back(std::exp(-dr * dr / (2 * sigma_l * sigma_l)));
+      }
+      local.push_back(std::move(l));
+    }
+  }
+};
+
 // Band descriptors (m x 8: mean of 4 row sums, std of 4 row sums) for one segment.
-void band_descriptors(const LineGradient& g, const LineSegment& s, const LbdOptions& o, float* bd) {
+void band_descriptors(const LineGradient& g, const LineSegment& s, const LbdOptions& o, const LbdWeights& wt,
+                      float* bd) {
   const int m = o.bands, w = o.band_width, R = m * w;
   const int W = g.gx.cols, H = g.gx.rows;
   const cv::Point2f a = g.to_working(s.start), b = g.to_working(s.end);
@@ -31,21 +56,33 @@ void band_descriptors(const LineGradient& g, const LineSegment& s, const LbdOpti
   const cv::Point2f n(-d.y, d.x);  // towards the bright side
   const int K = std::clamp(static_cast<int>(len) + 1, 2, o.max_samples_along);
   const cv::Point2f step = d * (len / (K - 1));
-  const float sigma_g = 0.5f * (R - 1), sigma_l = static_cast<float>(w);
 
+  const short* gxp = g.gx.ptr<short>();
+  const short* gyp = g.gy.ptr<short>();
+  const std::size_t gstride = g.gx.step1();
   // Row sums of (d_perp+, d_perp-, d_par+, d_par-), globally weighted, per sample.
   std::vector<float> rows(static_cast<std::size_t>(R) * 4, 0.f);
   for (int r = 0; r < R; ++r) {
     const float off = r - 0.5f * (R - 1);
-    const float wg = std::exp(-off * off / (2 * sigma_g * sigma_g)) / K;
+    const float wg = wt.global[r] / K;
     cv::Point2f p = a + n * off;
+    // Branch-free sums of the positive and negative parts: the signs are random in texture.
     float s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-    for (int k = 0; k < K; ++k, p += step) {
-      const int x = std::clamp(cvRound(p.x), 0, W - 1), y = std::clamp(cvRound(p.y), 0, H - 1);
-      const float gx = g.gx.ptr<short>(y)[x], gy = g.gy.ptr<short>(y)[x];
+    auto accumulate = [&](int x, int y) {
+      const float gx = gxp[y * gstride + x], gy = gyp[y * gstride + x];
       const float dp = gx * n.x + gy * n.y, dl = gx * d.x + gy * d.y;
-      (dp > 0 ? s0 : s1) += std::fabs(dp);
-      (dl > 0 ? s2 : s3) += std::fabs(dl);
+      s0 += std::max(dp, 0.f);
+      s1 += std::max(-dp, 0.f);
+      s2 += std::max(dl, 0.f);
+      s3 += std::max(-dl, 0.f);
+    };
+    const cv::Point2f q = p + step * static_cast<float>(K - 1);
+    if (std::min(p.x, q.x) >= 0 && std::min(p.y, q.y) >= 0 && std::max(p.x, q.x) <= W - 1 &&
+        std::max(p.y, q.y) <= H - 1) {
+      for (int k = 0; k < K; ++k, p += step) accumulate(cvRound(p.x), cvRound(p.y));  // row inside
+    } else {
+      for (int k = 0; k < K; ++k, p += step)
+        accumulate(std::clamp(cvRound(p.x), 0, W - 1), std::clamp(cvRound(p.y), 0, H - 1));
     }
     float* row = &rows[static_cast<std::size_t>(r) * 4];
     row[0] = s0 * wg;
@@ -54,12 +91,10 @@ void band_descriptors(const LineGradient& g, const LineSegment& s, const LbdOpti
     row[3] = s3 * wg;
   }
   for (int j = 0; j < m; ++j) {
-    const float centre = j * w + 0.5f * (w - 1);
     const int r0 = std::max(0, (j - 1) * w), r1 = std::min(R, (j + 2) * w);
     double sw = 0, mean[4] = {0, 0, 0, 0}, sq[4] = {0, 0, 0, 0};
     for (int r = r0; r < r1; ++r) {
-      const float dr = r - centre;
-      const double wl = std::exp(-dr * dr / (2 * sigma_l * sigma_l));
+      const double wl = wt.local[j][r - r0];
       sw += wl;
       for (int c = 0; c < 4; ++c) {
         const double v = rows[static_cast<std::size_t>(r) * 4 + c];
@@ -102,7 +137,8 @@ void check(const LineGradient& g, const LbdOptions& o) {
 cv::Mat describe_lines_float(const LineGradient& g, const std::vector<LineSegment>& segs, const LbdOptions& o) {
   check(g, o);
   cv::Mat out(static_cast<int>(segs.size()), o.bands * 8, CV_32F);
-  for (int i = 0; i < out.rows; ++i) band_descriptors(g, segs[i], o, out.ptr<float>(i));
+  const LbdWeights wt(o);
+  for (int i = 0; i < out.rows; ++i) band_descriptors(g, segs[i], o, wt, out.ptr<float>(i));
   return out;
 }
 
@@ -112,8 +148,9 @@ cv::Mat describe_lines(const LineGradient& g, const std::vector<LineSegment>& se
   if (pairs.size() * 8 < kLbdBytes * 8) throw std::invalid_argument("describe_lines: too few bands for 256 bits");
   cv::Mat out(static_cast<int>(segs.size()), kLbdBytes, CV_8U, cv::Scalar(0));
   std::vector<float> bd(static_cast<std::size_t>(o.bands) * 8);
+  const LbdWeights wt(o);
   for (int i = 0; i < out.rows; ++i) {
-    band_descriptors(g, segs[i], o, bd.data());
+    band_descriptors(g, segs[i], o, wt, bd.data());
     uint8_t* bits = out.ptr<uint8_t>(i);
     for (int p = 0; p < kLbdBytes; ++p) {
       const auto [bi, bj] = pairs[p];

@@ -82,29 +82,49 @@ std::vector<LineSegment> merge_segments(std::vector<LineSegment> segs, cv::Size 
   const double max_dtheta = o.max_theta_deg * CV_PI / 180.0;
   // Longest first, so each merge uses the most reliable line as the reference.
   std::sort(segs.begin(), segs.end(), [](const auto& a, const auto& b) { return a.length() > b.length(); });
-  std::vector<double> angle(segs.size());
   bool changed = true;
   while (changed) {
     changed = false;
-    for (std::size_t i = 0; i < segs.size(); ++i) angle[i] = to_hough(segs[i], frame.centre).theta;
-    std::vector<bool> dead(segs.size(), false);
-    for (std::size_t i = 0; i < segs.size(); ++i) {
+    const std::size_t n = segs.size();
+    // Candidates come from a window of the angle-sorted order, so a pass costs n log n plus the
+    // few same-angle pairs instead of n^2. The window is twice the gate because a fused
+    // segment's angle moves (by less than the gate) within the pass.
+    std::vector<double> angle(n);
+    std::vector<std::size_t> order(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      angle[i] = to_hough(segs[i], frame.centre).theta;
+      order[i] = i;
+    }
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return angle[a] < angle[b]; });
+    std::vector<double> sorted(n);
+    for (std::size_t k = 0; k < n; ++k) sorted[k] = angle[order[k]];
+    std::vector<bool> dead(n, false);
+    std::vector<std::size_t> cand;
+    for (std::size_t i = 0; i < n; ++i) {
       if (dead[i]) continue;
-      for (std::size_t j = i + 1; j < segs.size(); ++j) {
-        // Cheap angle reject before the full test: most pairs differ by far more than 1 degree.
-        if (dead[j] || hough_angle_difference(angle[i], angle[j]) >= max_dtheta) continue;
+      cand.clear();
+      const double lo = angle[i] - 2 * max_dtheta, hi = angle[i] + 2 * max_dtheta;
+      auto collect = [&](double a, double b) {  // sorted positions with angle in [a, b]
+        for (auto it = std::lower_bound(sorted.begin(), sorted.end(), a); it != sorted.end() && *it <= b; ++it)
+          cand.push_back(order[static_cast<std::size_t>(it - sorted.begin())]);
+      };
+      collect(std::max(0.0, lo), std::min(CV_PI, hi));
+      if (lo < 0) collect(lo + CV_PI, CV_PI);  // wrap at theta = 0 / pi
+      if (hi > CV_PI) collect(0.0, hi - CV_PI);
+      std::sort(cand.begin(), cand.end());
+      for (const std::size_t j : cand) {
+        if (j == i || dead[j]) continue;
         const bool i_longer = segs[i].length() >= segs[j].length();
         const LineSegment& a = i_longer ? segs[i] : segs[j];
         const LineSegment& b = i_longer ? segs[j] : segs[i];
         if (!can_merge(a, b, frame, o)) continue;
         segs[i] = fuse_segments(a, b);
-        angle[i] = to_hough(segs[i], frame.centre).theta;
         dead[j] = true;
         changed = true;
       }
     }
     std::size_t k = 0;
-    for (std::size_t i = 0; i < segs.size(); ++i)
+    for (std::size_t i = 0; i < n; ++i)
       if (!dead[i]) segs[k++] = segs[i];
     segs.resize(k);
   }
