@@ -13,18 +13,16 @@ MergeFrame MergeFrame::of(cv::Size s) {
 }
 
 bool can_merge(const LineSegment& a, const LineSegment& b, const MergeFrame& f, const LineMergeOptions& o) {
+  // Cheapest tests first: this runs for every pair in the angle window.
   const cv::Point2d da = a.end - a.start, db = b.end - b.start;
-  const double la = std::hypot(da.x, da.y), lb = std::hypot(db.x, db.y);
+  // sqrt rather than std::hypot: hypot's extra care costs more than the whole test here.
+  const double la = std::sqrt(da.x * da.x + da.y * da.y), lb = std::sqrt(db.x * db.x + db.y * db.y);
   if (la <= 0 || lb <= 0) return false;
   const double cos_ab = (da.x * db.x + da.y * db.y) / (la * lb);
   if (o.same_polarity && cos_ab <= 0) return false;
-
-  const HoughLine ha = to_hough(a, f.centre), hb = to_hough(b, f.centre);
-  const double dtheta = hough_angle_difference(ha.theta, hb.theta);
-  if (dtheta >= o.max_theta_deg * CV_PI / 180.0) return false;
-  // Across the theta wrap at pi the same line has the opposite rho.
-  const double rho_b = std::fabs(ha.theta - hb.theta) > CV_PI / 2 ? -hb.rho : hb.rho;
-  if (std::fabs(ha.rho - rho_b) >= o.max_rho_fraction * f.half_diagonal) return false;
+  // |dtheta| < tol  <=>  |sin dtheta| < sin tol (for angles below 90 degrees).
+  const double sin_ab = std::fabs(da.x * db.y - da.y * db.x) / (la * lb);
+  if (sin_ab >= std::sin(o.max_theta_deg * CV_PI / 180.0)) return false;
 
   if (distance_to_line(a, b.start) > o.max_endpoint_distance_px ||
       distance_to_line(a, b.end) > o.max_endpoint_distance_px)
@@ -37,7 +35,13 @@ bool can_merge(const LineSegment& a, const LineSegment& b, const MergeFrame& f, 
   const double gap = std::max(t1 - la, -t2);  // positive when disjoint
   if (gap > o.max_gap_px) return false;
   const double overlap = std::min(la, t2) - std::max(0.0, t1);
-  return overlap <= o.max_overlap_px;
+  if (overlap > o.max_overlap_px) return false;
+
+  const HoughLine ha = to_hough(a, f.centre), hb = to_hough(b, f.centre);
+  if (hough_angle_difference(ha.theta, hb.theta) >= o.max_theta_deg * CV_PI / 180.0) return false;
+  // Across the theta wrap at pi the same line has the opposite rho.
+  const double rho_b = std::fabs(ha.theta - hb.theta) > CV_PI / 2 ? -hb.rho : hb.rho;
+  return std::fabs(ha.rho - rho_b) < o.max_rho_fraction * f.half_diagonal;
 }
 
 LineSegment fuse_segments(const LineSegment& a, const LineSegment& b) {
@@ -80,6 +84,7 @@ std::vector<LineSegment> merge_segments(std::vector<LineSegment> segs, cv::Size 
                                         const LineMergeOptions& o) {
   const MergeFrame frame = MergeFrame::of(image_size);
   const double max_dtheta = o.max_theta_deg * CV_PI / 180.0;
+  const double max_drho = o.max_rho_fraction * frame.half_diagonal;
   // Longest first, so each merge uses the most reliable line as the reference.
   std::sort(segs.begin(), segs.end(), [](const auto& a, const auto& b) { return a.length() > b.length(); });
   bool changed = true;
@@ -89,10 +94,12 @@ std::vector<LineSegment> merge_segments(std::vector<LineSegment> segs, cv::Size 
     // Candidates come from a window of the angle-sorted order, so a pass costs n log n plus the
     // few same-angle pairs instead of n^2. The window is twice the gate because a fused
     // segment's angle moves (by less than the gate) within the pass.
-    std::vector<double> angle(n);
+    std::vector<double> angle(n), rho(n);
     std::vector<std::size_t> order(n);
     for (std::size_t i = 0; i < n; ++i) {
-      angle[i] = to_hough(segs[i], frame.centre).theta;
+      const HoughLine h = to_hough(segs[i], frame.centre);
+      angle[i] = h.theta;
+      rho[i] = h.rho;
       order[i] = i;
     }
     std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return angle[a] < angle[b]; });
@@ -111,9 +118,11 @@ std::vector<LineSegment> merge_segments(std::vector<LineSegment> segs, cv::Size 
       collect(std::max(0.0, lo), std::min(CV_PI, hi));
       if (lo < 0) collect(lo + CV_PI, CV_PI);  // wrap at theta = 0 / pi
       if (hi > CV_PI) collect(0.0, hi - CV_PI);
-      std::sort(cand.begin(), cand.end());
       for (const std::size_t j : cand) {
         if (j == i || dead[j]) continue;
+        // Same rho prefilter (with the sign flip across the wrap), again with a margin of 2.
+        const double rho_j = std::fabs(angle[i] - angle[j]) > CV_PI / 2 ? -rho[j] : rho[j];
+        if (std::fabs(rho[i] - rho_j) > 2 * max_drho) continue;
         const bool i_longer = segs[i].length() >= segs[j].length();
         const LineSegment& a = i_longer ? segs[i] : segs[j];
         const LineSegment& b = i_longer ? segs[j] : segs[i];

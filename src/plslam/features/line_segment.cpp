@@ -20,7 +20,7 @@ double hough_angle_difference(double a, double b) {
 
 double distance_to_line(const LineSegment& s, const cv::Point2f& p) {
   const cv::Point2d d = s.end - s.start;
-  const double n = std::hypot(d.x, d.y);
+  const double n = std::sqrt(d.x * d.x + d.y * d.y);
   if (n <= 0) return cv::norm(p - s.start);
   const cv::Point2d v = cv::Point2d(p) - cv::Point2d(s.start);
   return std::fabs(d.x * v.y - d.y * v.x) / n;
