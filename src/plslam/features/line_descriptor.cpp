@@ -79,7 +79,11 @@ void band_descriptors(const LineGradient& g, const LineSegment& s, const LbdOpti
     const cv::Point2f q = p + step * static_cast<float>(K - 1);
     if (std::min(p.x, q.x) >= 0 && std::min(p.y, q.y) >= 0 && std::max(p.x, q.x) <= W - 1 &&
         std::max(p.y, q.y) <= H - 1) {
-      for (int k = 0; k < K; ++k, p += step) accumulate(cvRound(p.x), cvRound(p.y));  // row inside
+      // Row inside the image: 16.16 fixed-point stepping, floor(x + 0.5) rounds.
+      int32_t fx = static_cast<int32_t>((p.x + 0.5f) * 65536.f), fy = static_cast<int32_t>((p.y + 0.5f) * 65536.f);
+      const int32_t sx = static_cast<int32_t>(std::lround(step.x * 65536.f));
+      const int32_t sy = static_cast<int32_t>(std::lround(step.y * 65536.f));
+      for (int k = 0; k < K; ++k, fx += sx, fy += sy) accumulate(std::min(fx >> 16, W - 1), std::min(fy >> 16, H - 1));
     } else {
       for (int k = 0; k < K; ++k, p += step)
         accumulate(std::clamp(cvRound(p.x), 0, W - 1), std::clamp(cvRound(p.y), 0, H - 1));

@@ -21,7 +21,7 @@ constexpr int kLbdBytes = 32;  // 256 bits
 struct LbdOptions {
   int bands = 9;               // m
   int band_width = 5;          // w, rows of the working image (10 full-resolution px at scale 1/2)
-  int max_samples_along = 20;  // samples along the segment per row
+  int max_samples_along = 12;  // samples along the segment per row
 };
 
 // One row of 32 bytes (CV_8U) per segment, in the order of `segments`.

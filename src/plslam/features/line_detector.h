@@ -25,7 +25,7 @@ struct LineDetectorOptions {
   double scale = 0.5;          // working scale of the image (both detectors and the gradient)
   double min_length_px = 14;   // full-resolution pixels
   // kGrow
-  float min_gradient = 24;         // Sobel magnitude (4x intensity step) a pixel needs to join
+  float min_gradient = 32;         // Sobel magnitude (4x intensity step) a pixel needs to join
   float angle_tolerance_deg = 22.5;  // region growing: gradient within this of the region's
   float min_density = 0.4;         // region pixels / rectangle area, after trimming
   float max_half_width = 2.0;      // working pixels kept either side of the fitted line
