@@ -1,10 +1,8 @@
 // Line front end on real frames, one core: OpenCV LSD vs our region-growing detector, merging,
 // our LBD vs OpenCV's LBD on the same lines, the whole per-image extraction, and stereo line
-// matching. Frames: EuRoC V1_01 micro cam0/cam1 (unrectified; fine for timing) and KITTI 06.
+// matching. Frames: the first 20 of EuRoC V1_01 micro (rectified by the reader) and KITTI 06.
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -14,6 +12,7 @@
 #include <opencv2/line_descriptor.hpp>
 
 #include "plslam/features/line_extractor.h"
+#include "plslam/io/dataset.h"
 #include "plslam/matching/stereo_line_matcher.h"
 
 namespace fs = std::filesystem;
@@ -33,42 +32,30 @@ fs::path data_dir() {
   return fs::path(PLSLAM_DEFAULT_SHARED_DIR) / "data";
 }
 
-std::vector<fs::path> sorted_pngs(const fs::path& dir, std::size_t max) {
-  std::vector<fs::path> v;
-  if (!fs::is_directory(dir)) return v;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().extension() == ".png") v.push_back(e.path());
-  std::sort(v.begin(), v.end());
-  if (v.size() > max) v.resize(max);
-  return v;
+// First 20 frames through the project's dataset reader (EuRoC rectified, KITTI as is); empty
+// when the shared data is absent.
+Sequence load(const fs::path& path, LineExtractorOptions options) {
+  Sequence q;
+  q.options = options;
+  if (!fs::exists(path)) return q;
+  io::DatasetOptions d;
+  d.max_frames = 20;
+  const auto ds = io::open_dataset(path, d);
+  q.calib = ds->calibration();
+  for (std::size_t i = 0; i < ds->size(); ++i) {
+    io::StereoFrame f = ds->load(i);
+    q.frames.emplace_back(std::move(f.left), std::move(f.right));
+  }
+  return q;
 }
 
 const Sequence& euroc() {
-  static const Sequence s = [] {
-    Sequence q;
-    const fs::path root = data_dir() / "euroc/V1_01_easy_micro/mav0";
-    for (const auto& p : sorted_pngs(root / "cam0/data", 20))
-      q.frames.emplace_back(cv::imread(p.string(), cv::IMREAD_GRAYSCALE),
-                            cv::imread((root / "cam1/data" / p.filename()).string(), cv::IMREAD_GRAYSCALE));
-    // cam0 intrinsics of EuRoC; the pair is not rectified, so stereo numbers here are timing only.
-    q.calib = {752, 480, 458.654, 457.296, 367.215, 248.375, 0.110};
-    q.options = LineExtractorOptions::euroc();
-    return q;
-  }();
+  static const Sequence s = load(data_dir() / "euroc/V1_01_easy_micro", LineExtractorOptions::euroc());
   return s;
 }
 
 const Sequence& kitti() {
-  static const Sequence s = [] {
-    Sequence q;
-    const fs::path root = data_dir() / "kitti/sequences/06";
-    for (const auto& p : sorted_pngs(root / "image_0", 20))
-      q.frames.emplace_back(cv::imread(p.string(), cv::IMREAD_GRAYSCALE),
-                            cv::imread((root / "image_1" / p.filename()).string(), cv::IMREAD_GRAYSCALE));
-    q.calib = {1226, 370, 707.0912, 707.0912, 601.8873, 183.1104, 379.8145 / 707.0912};
-    q.options = LineExtractorOptions::kitti();
-    return q;
-  }();
+  static const Sequence s = load(data_dir() / "kitti/sequences/06", LineExtractorOptions::kitti());
   return s;
 }
 

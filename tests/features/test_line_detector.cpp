@@ -1,5 +1,6 @@
 // Detection and merging against the exact ground truth of a synthetic scene, plus bounds on
 // real frames.
+#include <cstdio>
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -41,6 +42,7 @@ TEST(LineDetector, RecallOnSyntheticSceneBothDetectors) {
     o.detector.scale = kind == LineDetectorKind::kLsd ? 1.0 : 0.5;
     const LineFeatures f = extract_lines(s.left, o);
     const double r = recall_long_edges(s, f.lines, 40, true);
+    std::printf("%s: recall %.3f of quad edges > 40 px\n", to_string(kind), r);
     EXPECT_GE(r, 0.8) << to_string(kind);
     save_overlay(s.left, f.lines, std::string("lines_synthetic_") + to_string(kind) + ".png");
     // Accuracy: segments on a GT edge sit within 1 px of it on average.
@@ -54,6 +56,7 @@ TEST(LineDetector, RecallOnSyntheticSceneBothDetectors) {
           ++n;
         }
     ASSERT_GT(n, 20);
+    std::printf("%s: mean endpoint distance to GT line %.3f px over %d segments\n", to_string(kind), sum / n, n);
     EXPECT_LT(sum / n, 1.0) << to_string(kind);
   }
 }
@@ -76,6 +79,7 @@ TEST(LineDetector, MergingReducesFragmentsWithoutFusingDistinctEdges) {
     return n;
   };
   const int before = pieces_on_quads(det.segments), after = pieces_on_quads(merged);
+  std::printf("fragments on quad edges: %d before merging, %d after\n", before, after);
   ASSERT_GT(before, 30);
   EXPECT_LE(after, 0.7 * before) << "before " << before << " after " << after;
 
@@ -90,6 +94,7 @@ TEST(LineDetector, MergingReducesFragmentsWithoutFusingDistinctEdges) {
         break;
       }
   }
+  std::printf("merged segments on one GT edge: %d of %d\n", correct, fused);
   ASSERT_GT(fused, 10);
   EXPECT_GE(static_cast<double>(correct) / fused, 0.95) << correct << " of " << fused;
 }

@@ -1,5 +1,7 @@
 // Stereo line matching: endpoint depth against the synthetic scene's exact geometry, the
 // rejection of near-horizontal lines, line coefficients, and counts on KITTI 06.
+#include <cstdio>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -33,6 +35,8 @@ TEST(StereoLines, EndpointDepthWithinTwoPercentOnSyntheticScene) {
       break;
     }
   }
+  std::printf("synthetic stereo: %zu matches, %d on GT edges, %d within 2%% depth, worst %.4f\n", matches.size(),
+              on_gt, within, worst);
   // Every quad edge that is not near-horizontal (about 20 of them) should be matched.
   EXPECT_GE(on_gt, 16) << matches.size() << " matches";
   EXPECT_GE(static_cast<double>(on_gt) / matches.size(), 0.95);
@@ -113,6 +117,7 @@ TEST(StereoLines, KittiFramesGiveManyMatches) {
     }
   }
   std::sort(counts.begin(), counts.end());
+  std::printf("KITTI 06 stereo line matches: %.0f %.0f %.0f\n", counts[0], counts[1], counts[2]);
   EXPECT_GE(counts[1], 100) << "median stereo line matches";
 }
 
