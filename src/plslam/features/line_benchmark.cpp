@@ -4,6 +4,7 @@
 #include <chrono>
 #include <stdexcept>
 
+#include <opencv2/imgproc.hpp>
 #include <opencv2/line_descriptor.hpp>
 
 namespace plslam::features {
@@ -64,11 +65,11 @@ nlohmann::json benchmark_lines(const std::vector<std::pair<cv::Mat, cv::Mat>>& f
   fast_opts.detector.kind = LineDetectorKind::kGrow;
   for (const auto& [left, right] : frames) {
     if (o.reference) {
-      LineDetectorOptions ref;
-      ref.kind = LineDetectorKind::kLsd;
-      ref.scale = 1.0;
+      // OpenCV's own LSD alone (default parameters, no refinement), full resolution.
+      auto detector = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE);
+      std::vector<cv::Vec4f> raw;
       const auto t0 = std::chrono::steady_clock::now();
-      const DetectedLines d = detect_lines(left, ref);
+      detector->detect(left, raw);
       lsd.push_back(ms_since(t0));
     }
     LineTimings tl, tr;
