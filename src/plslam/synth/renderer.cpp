@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace plslam::synth {
 
@@ -13,25 +14,27 @@ constexpr float kEdgeEps = 1e-5f;
 // Rotated-grid 4x supersampling pattern (offsets from the pixel centre).
 constexpr float kSub[4][2] = {{-0.125f, -0.375f}, {0.375f, -0.125f}, {0.125f, 0.375f}, {-0.375f, 0.125f}};
 
-float bilinear(const TextureLevel& lv, bool repeat, float u, float v) {
+inline float bilinear(const TextureLevel& lv, bool repeat, float u, float v) {
   const int n = lv.size;
   const float uu = u - 0.5f, vv = v - 0.5f;
-  const float fu = std::floor(uu), fv = std::floor(vv);
+  // floor() without a libm call: truncate, then step down for negatives.
+  int iu = static_cast<int>(uu), iv = static_cast<int>(vv);
+  iu -= uu < static_cast<float>(iu);
+  iv -= vv < static_cast<float>(iv);
+  const float fu = static_cast<float>(iu), fv = static_cast<float>(iv);
   const float au = uu - fu, av = vv - fv;
   int x0, x1, y0, y1;
   if (repeat) {
     const int m = n - 1;
-    x0 = static_cast<int>(static_cast<long>(fu) & m);
-    y0 = static_cast<int>(static_cast<long>(fv) & m);
+    x0 = iu & m;
+    y0 = iv & m;
     x1 = (x0 + 1) & m;
     y1 = (y0 + 1) & m;
   } else {
-    x0 = std::clamp(static_cast<int>(fu), 0, n - 1);
-    y0 = std::clamp(static_cast<int>(fv), 0, n - 1);
-    x1 = std::min(x0 + 1, n - 1);
-    y1 = std::min(y0 + 1, n - 1);
-    if (fu < 0) x1 = 0;
-    if (fv < 0) y1 = 0;
+    x0 = std::clamp(iu, 0, n - 1);
+    y0 = std::clamp(iv, 0, n - 1);
+    x1 = std::clamp(iu + 1, 0, n - 1);
+    y1 = std::clamp(iv + 1, 0, n - 1);
   }
   const float* r0 = &lv.texels[static_cast<std::size_t>(y0) * n];
   const float* r1 = &lv.texels[static_cast<std::size_t>(y1) * n];
@@ -48,6 +51,7 @@ Renderer::Renderer(const Scene& scene, const PinholeCamera& camera) : scene_(sce
   const std::size_t n = static_cast<std::size_t>(cam_.width) * cam_.height;
   inv_depth_.resize(n);
   id_.resize(n);
+  edge_.resize(n);
 }
 
 bool Renderer::setup_quad(int qi, const Eigen::Matrix3d& R_cw, const Eigen::Vector3d& t_cw, QuadView& qv) const {
@@ -158,7 +162,7 @@ float Renderer::coverage(int qi, float x, float y) const {
   return iz;
 }
 
-float Renderer::shade(int qi, float x, float y) const {
+Renderer::PointShading Renderer::point_shading(int qi, float x, float y) const {
   const QuadView& v = views_[qi];
   const Quad& q = scene_.quads[qi];
   const Texture& tex = scene_.textures[q.texture];
@@ -168,23 +172,18 @@ float Renderer::shade(int qi, float x, float y) const {
   const float t = std::clamp((v.b.x() * x + v.b.y() * y + v.b.z()) * iw, 0.0f, 1.0f);
   const float n0 = static_cast<float>(tex.size());
   const float su = q.repeat_u * n0, sv = q.repeat_v * n0;
-  // Texel footprint of one pixel from the homography's derivatives -> mip level.
+  // Texel footprint of one pixel from the homography's derivatives -> mip level
+  // floor(log2(footprint)) = floor(exponent(f2) / 2), read from the float's bits.
   const float dudx = (v.a.x() - s * v.w.x()) * iw * su, dvdx = (v.b.x() - t * v.w.x()) * iw * sv;
   const float dudy = (v.a.y() - s * v.w.y()) * iw * su, dvdy = (v.b.y() - t * v.w.y()) * iw * sv;
   const float f2 = std::max(dudx * dudx + dvdx * dvdx, dudy * dudy + dvdy * dvdy);
   const int top = static_cast<int>(tex.levels.size()) - 1;
-  const float u = s * su, vv = t * sv;
-  float value;
-  if (f2 <= 1.0f) {
-    value = bilinear(tex.levels[0], tex.repeat, u, vv);
-  } else {
-    const float lod = std::min(0.5f * std::log2(f2), static_cast<float>(top));
-    const int l0 = std::min(static_cast<int>(lod), top), l1 = std::min(l0 + 1, top);
-    const float a = lod - static_cast<float>(l0);
-    const float s0 = 1.0f / static_cast<float>(1 << l0);
-    const float v0 = bilinear(tex.levels[l0], tex.repeat, u * s0, vv * s0);
-    const float v1 = bilinear(tex.levels[l1], tex.repeat, u * s0 * 0.5f, vv * s0 * 0.5f);
-    value = v0 + (v1 - v0) * a;
+  PointShading out;
+  out.level = 0;
+  if (f2 > 1.0f) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &f2, sizeof bits);
+    out.level = std::min(static_cast<int>((bits >> 23) & 0xffu) - 127, 2 * top) / 2;
   }
   // Baked illumination, bilinear over the quad's grid.
   const float gx = s * static_cast<float>(q.grid_u - 1), gy = t * static_cast<float>(q.grid_v - 1);
@@ -193,7 +192,48 @@ float Renderer::shade(int qi, float x, float y) const {
   const float* L0 = &q.light[static_cast<std::size_t>(iy) * q.grid_u + ix];
   const float* L1 = L0 + q.grid_u;
   const float l0 = L0[0] + (L0[1] - L0[0]) * ax, l1 = L1[0] + (L1[1] - L1[0]) * ax;
-  return value * (l0 + (l1 - l0) * ay);
+  out.light = l0 + (l1 - l0) * ay;
+  out.s = s;
+  out.t = t;
+  return out;
+}
+
+float Renderer::shade(int qi, float x, float y) const {
+  const Quad& q = scene_.quads[qi];
+  const Texture& tex = scene_.textures[q.texture];
+  const PointShading p = point_shading(qi, x, y);
+  const float scale = static_cast<float>(tex.size()) / static_cast<float>(1 << p.level);
+  return p.light * bilinear(tex.levels[p.level], tex.repeat, p.s * q.repeat_u * scale, p.t * q.repeat_v * scale);
+}
+
+void Renderer::shade_run(int qi, int y, int x0, int x1, float* out) const {
+  // Mip level and illumination vary slowly: evaluate them at the ends of blocks of 8 pixels
+  // and interpolate; the texture coordinates themselves are exact per pixel.
+  constexpr int kBlock = 8;
+  const QuadView& v = views_[qi];
+  const Quad& q = scene_.quads[qi];
+  const Texture& tex = scene_.textures[q.texture];
+  const float fy = static_cast<float>(y);
+  const float ar = v.a.y() * fy + v.a.z(), br = v.b.y() * fy + v.b.z(), wr = v.w.y() * fy + v.w.z();
+  const float n0 = static_cast<float>(tex.size());
+  PointShading next = point_shading(qi, static_cast<float>(x0), fy);
+  for (int xb = x0; xb < x1; xb += kBlock) {
+    const int xe = std::min(xb + kBlock, x1);
+    const PointShading first = next;
+    next = point_shading(qi, static_cast<float>(xe), fy);
+    const TextureLevel& lv = tex.levels[first.level];
+    const float scale = n0 / static_cast<float>(1 << first.level);
+    const float su = q.repeat_u * scale, sv = q.repeat_v * scale;
+    const float dl = (next.light - first.light) / static_cast<float>(xe - xb);
+    float light = first.light;
+    for (int x = xb; x < xe; ++x, light += dl) {
+      const float fx = static_cast<float>(x);
+      const float iw = 1.0f / (v.w.x() * fx + wr);
+      const float s = std::clamp((v.a.x() * fx + ar) * iw, 0.0f, 1.0f);
+      const float t = std::clamp((v.b.x() * fx + br) * iw, 0.0f, 1.0f);
+      out[x] = light * bilinear(lv, tex.repeat, s * su, t * sv);
+    }
+  }
 }
 
 void Renderer::render(const Eigen::Isometry3d& T_wc, cv::Mat& radiance, cv::Mat* depth) {
@@ -203,28 +243,58 @@ void Renderer::render(const Eigen::Isometry3d& T_wc, cv::Mat& radiance, cv::Mat*
   const int W = cam_.width, H = cam_.height;
   std::fill(inv_depth_.begin(), inv_depth_.end(), 0.0f);
   std::fill(id_.begin(), id_.end(), -1);
+  // Front to back (by the distance to each quad's closest point), so that the depth test
+  // rejects most hidden pixels before any division.
+  order_.clear();
+  const Eigen::Vector3d cam_w = T_wc.translation();
   for (std::size_t qi = 0; qi < scene_.quads.size(); ++qi) {
     visible_[qi] = setup_quad(static_cast<int>(qi), R_cw, t_cw, views_[qi]);
-    if (visible_[qi]) rasterize(static_cast<int>(qi), R_cw, t_cw);
+    if (!visible_[qi]) continue;
+    const Quad& q = scene_.quads[qi];
+    const Eigen::Vector3d d = cam_w - q.origin;
+    const double s = std::clamp(d.dot(q.u) / q.u.squaredNorm(), 0.0, 1.0);
+    const double t = std::clamp(d.dot(q.v) / q.v.squaredNorm(), 0.0, 1.0);
+    order_.push_back({(q.origin + s * q.u + t * q.v - cam_w).squaredNorm(), static_cast<int>(qi)});
   }
+  std::sort(order_.begin(), order_.end());
+  for (const auto& [dist, qi] : order_) rasterize(qi, R_cw, t_cw);
 
   radiance.create(H, W, CV_32F);
   for (int y = 0; y < H; ++y) {
     float* out = radiance.ptr<float>(y);
     const std::int32_t* ib = &id_[static_cast<std::size_t>(y) * W];
-    for (int x = 0; x < W; ++x)
-      out[x] = ib[x] < 0 ? scene_.background : shade(ib[x], static_cast<float>(x), static_cast<float>(y));
+    for (int x = 0; x < W;) {
+      int end = x + 1;
+      while (end < W && ib[end] == ib[x]) ++end;
+      if (ib[x] < 0) std::fill(out + x, out + end, scene_.background);
+      else shade_run(ib[x], y, x, end, out);
+      x = end;
+    }
   }
 
   // Anti-aliasing: re-shade pixels whose 4-neighbourhood sees another surface.
+  // Branch-free marking first (both sides of every horizontal and vertical change).
+  std::fill(edge_.begin(), edge_.end(), std::uint8_t{0});
   for (int y = 0; y < H; ++y) {
     const std::int32_t* ib = &id_[static_cast<std::size_t>(y) * W];
+    std::uint8_t* e = &edge_[static_cast<std::size_t>(y) * W];
+    for (int x = 0; x + 1 < W; ++x) {
+      const std::uint8_t d = ib[x] != ib[x + 1];
+      e[x] |= d;
+      e[x + 1] |= d;
+    }
+    if (y + 1 < H)
+      for (int x = 0; x < W; ++x) {
+        const std::uint8_t d = ib[x] != ib[x + W];
+        e[x] |= d;
+        e[x + W] |= d;
+      }
+  }
+  for (int y = 0; y < H; ++y) {
     float* out = radiance.ptr<float>(y);
+    const std::uint8_t* e = &edge_[static_cast<std::size_t>(y) * W];
     for (int x = 0; x < W; ++x) {
-      const std::int32_t c = ib[x];
-      const bool edge = (x > 0 && ib[x - 1] != c) || (x + 1 < W && ib[x + 1] != c) ||
-                        (y > 0 && ib[x - W] != c) || (y + 1 < H && ib[x + W] != c);
-      if (!edge) continue;
+      if (!e[x]) continue;
       std::int32_t cand[9];
       int nc = 0;
       for (int dy = -1; dy <= 1; ++dy)
@@ -234,20 +304,29 @@ void Renderer::render(const Eigen::Isometry3d& T_wc, cv::Mat& radiance, cv::Mat*
           const std::int32_t id = id_[static_cast<std::size_t>(yy) * W + xx];
           if (id >= 0 && std::find(cand, cand + nc, id) == cand + nc) cand[nc++] = id;
         }
-      float sum = 0;
+      // Coverage of each candidate by the 4 sub-samples; each covering surface is shaded once,
+      // at its first covered sub-sample, and weighted by its coverage.
+      int count[10] = {0};
+      float at_x[10], at_y[10];
       for (const auto& o : kSub) {
         const float sx = static_cast<float>(x) + o[0], sy = static_cast<float>(y) + o[1];
-        std::int32_t best = -1;
+        int best = nc;  // nc stands for the background
         float best_iz = 0;
         for (int k = 0; k < nc; ++k) {
           const float iz = coverage(cand[k], sx, sy);
           if (iz > best_iz) {
             best_iz = iz;
-            best = cand[k];
+            best = k;
           }
         }
-        sum += best < 0 ? scene_.background : shade(best, sx, sy);
+        if (count[best]++ == 0) {
+          at_x[best] = sx;
+          at_y[best] = sy;
+        }
       }
+      float sum = static_cast<float>(count[nc]) * scene_.background;
+      for (int k = 0; k < nc; ++k)
+        if (count[k] > 0) sum += static_cast<float>(count[k]) * shade(cand[k], at_x[k], at_y[k]);
       out[x] = 0.25f * sum;
     }
   }

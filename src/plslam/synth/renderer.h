@@ -5,6 +5,7 @@
 // pixel, trilinear mip filtering), and pixels on a boundary between surfaces are re-shaded with
 // 4 rotated-grid sub-samples for anti-aliasing.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -43,7 +44,14 @@ class Renderer {
 
   bool setup_quad(int qi, const Eigen::Matrix3d& R_cw, const Eigen::Vector3d& t_cw, QuadView& qv) const;
   void rasterize(int qi, const Eigen::Matrix3d& R_cw, const Eigen::Vector3d& t_cw);
+  struct PointShading {
+    float s, t, light;
+    int level;
+  };
+  PointShading point_shading(int qi, float x, float y) const;
   float shade(int qi, float x, float y) const;
+  // Shades the pixels [x0, x1) of row y, all showing quad qi.
+  void shade_run(int qi, int y, int x0, int x1, float* out) const;
   // Covers (x, y) with quad qi? Returns inverse depth (> 0) or 0.
   float coverage(int qi, float x, float y) const;
 
@@ -53,6 +61,8 @@ class Renderer {
   std::vector<std::uint8_t> visible_;
   std::vector<float> inv_depth_;
   std::vector<std::int32_t> id_;
+  std::vector<std::uint8_t> edge_;
+  std::vector<std::pair<double, int>> order_;
 };
 
 }  // namespace plslam::synth
