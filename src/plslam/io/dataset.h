@@ -47,6 +47,13 @@ class Dataset {
   // the format pairs it by index (KITTI), or the whole file's overlap in time (EuRoC).
   const std::optional<Trajectory>& ground_truth() const { return gt_; }
   const std::filesystem::path& ground_truth_path() const { return gt_path_; }
+  // Path length of the ground truth in metres (0 without ground truth).
+  double ground_truth_length() const;
+
+  // Rotation from the raw left sensor frame to the rectified left camera frame (identity for
+  // KITTI, whose images come rectified). Ground truth is given for the raw left sensor, as
+  // datasets and published tables do: T_w_rect = T_w_sensor * R_rect_sensor^T.
+  const Eigen::Matrix3d& rectification_rotation() const { return R_rect_sensor_; }
 
   // Loads and rectifies frame i (0-based within the selected range). A missing or corrupt image
   // throws InputError naming the file.
@@ -58,6 +65,7 @@ class Dataset {
   std::vector<double> timestamps_;
   std::optional<Trajectory> gt_;
   std::filesystem::path gt_path_;
+  Eigen::Matrix3d R_rect_sensor_ = Eigen::Matrix3d::Identity();
 };
 
 // Opens a KITTI odometry sequence folder (sequences/NN) or an EuRoC/ASL sequence (<seq> or

@@ -1,0 +1,22 @@
+#pragma once
+// Internal: the concrete readers behind open_dataset(). Not for use outside io/.
+#include <memory>
+
+#include "plslam/io/dataset.h"
+
+namespace plslam::io::detail {
+
+std::unique_ptr<Dataset> open_kitti(const std::filesystem::path& sequence_dir, const DatasetOptions& options);
+std::unique_ptr<Dataset> open_euroc(const std::filesystem::path& mav0_dir, const DatasetOptions& options);
+
+// Applies --start/--max-frames to an index list; throws InputError when nothing is left.
+std::pair<std::size_t, std::size_t> select_range(std::size_t total, const DatasetOptions& options,
+                                                 const std::filesystem::path& root);
+
+// Throws InputError(file, "timestamps not increasing ...") unless strictly increasing.
+void check_increasing(const std::vector<double>& t, const std::filesystem::path& file);
+
+// Fails unless the calibration holds finite, positive focal lengths and a positive baseline.
+void validate_calibration(const StereoCalibration& c, const std::filesystem::path& file);
+
+}  // namespace plslam::io::detail

@@ -1,0 +1,198 @@
+// EuRoC / ASL: mav0/cam{0,1}/{data.csv, data/, sensor.yaml}, ground truth in
+// mav0/state_groundtruth_estimate0/data.csv (body frame). The raw images are distorted and not
+// rectified: rectification is computed once from the two sensor.yaml files and every frame is
+// remapped, so the rest of the system sees an ideal rectified pinhole pair.
+#include <charconv>
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <Eigen/Core>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+#include "plslam/core/error.h"
+#include "plslam/io/dataset_impl.h"
+#include "plslam/io/euroc_sensor.h"
+#include "plslam/io/image_loading.h"
+#include "plslam/io/trajectory_io.h"
+
+namespace plslam::io::detail {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ImageEntry {
+  std::int64_t ns = 0;
+  std::string file;
+};
+
+std::vector<ImageEntry> read_image_list(const fs::path& csv) {
+  if (!fs::exists(csv)) throw InputError(csv.string(), "file not found");
+  std::ifstream in(csv);
+  if (!in) throw InputError(csv.string(), "cannot open file");
+  std::vector<ImageEntry> entries;
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    const auto comma = line.find(',');
+    if (comma == std::string::npos) {
+      throw InputError(csv.string(), fmt::format("line {}: expected 'timestamp,filename'", line_no));
+    }
+    ImageEntry e;
+    const auto [ptr, ec] = std::from_chars(line.data(), line.data() + comma, e.ns);
+    if (ec != std::errc() || ptr != line.data() + comma) {
+      throw InputError(csv.string(), fmt::format("line {}: bad timestamp '{}'", line_no, line.substr(0, comma)));
+    }
+    e.file = line.substr(comma + 1);
+    e.file.erase(0, e.file.find_first_not_of(' '));
+    if (!entries.empty() && e.ns <= entries.back().ns) {
+      throw InputError(csv.string(), fmt::format("line {}: timestamps not increasing ({} after {})", line_no,
+                                                 e.ns, entries.back().ns));
+    }
+    entries.push_back(std::move(e));
+  }
+  if (entries.empty()) throw InputError(csv.string(), "no images listed");
+  return entries;
+}
+
+cv::Mat camera_matrix(const EurocCameraSensor& s) {
+  return (cv::Mat_<double>(3, 3) << s.fu, 0, s.cu, 0, s.fv, s.cv, 0, 0, 1);
+}
+
+class EurocDataset final : public Dataset {
+ public:
+  EurocDataset(const fs::path& mav0, const DatasetOptions& options) {
+    root_ = mav0;
+    const auto yaml0 = mav0 / "cam0" / "sensor.yaml";
+    const auto yaml1 = mav0 / "cam1" / "sensor.yaml";
+    cam0_ = read_euroc_camera_yaml(yaml0);
+    const auto cam1 = read_euroc_camera_yaml(yaml1);
+    if (cam0_.width != cam1.width || cam0_.height != cam1.height) {
+      throw InputError(yaml1.string(), fmt::format("resolution {}x{} differs from cam0's {}x{}", cam1.width,
+                                                   cam1.height, cam0_.width, cam0_.height));
+    }
+    compute_rectification(cam1, yaml1);
+
+    const auto left = read_image_list(mav0 / "cam0" / "data.csv");
+    const auto right = read_image_list(mav0 / "cam1" / "data.csv");
+    pair_images(left, right);
+    if (!fs::is_directory(mav0 / "cam0" / "data")) {
+      throw InputError((mav0 / "cam0" / "data").string(), "image folder not found");
+    }
+
+    const auto [start, count] = select_range(pairs_.size(), options, root_);
+    pairs_ = std::vector<Pair>(pairs_.begin() + static_cast<std::ptrdiff_t>(start),
+                               pairs_.begin() + static_cast<std::ptrdiff_t>(start + count));
+    for (const auto& p : pairs_) timestamps_.push_back(static_cast<double>(p.ns) * 1e-9);
+
+    load_ground_truth();
+    // Fail early on a corrupt first pair or a size that contradicts sensor.yaml.
+    (void)load(0);
+  }
+
+  DatasetFormat format() const override { return DatasetFormat::kEuroc; }
+
+  StereoFrame load(std::size_t i) const override {
+    const auto& p = pairs_.at(i);
+    StereoFrame f;
+    f.index = i;
+    f.timestamp = timestamps_[i];
+    f.left_path = root_ / "cam0" / "data" / p.left;
+    f.right_path = root_ / "cam1" / "data" / p.right;
+    const cv::Mat raw_left = load_grey_image(f.left_path);
+    const cv::Mat raw_right = load_grey_image(f.right_path);
+    for (const auto& [img, path] : {std::pair{&raw_left, &f.left_path}, std::pair{&raw_right, &f.right_path}}) {
+      if (img->cols != cam0_.width || img->rows != cam0_.height) {
+        throw InputError(path->string(), fmt::format("image is {}x{} but sensor.yaml says {}x{}", img->cols,
+                                                     img->rows, cam0_.width, cam0_.height));
+      }
+    }
+    cv::remap(raw_left, f.left, map_left_[0], map_left_[1], cv::INTER_LINEAR);
+    cv::remap(raw_right, f.right, map_right_[0], map_right_[1], cv::INTER_LINEAR);
+    return f;
+  }
+
+ private:
+  struct Pair {
+    std::int64_t ns;
+    std::string left, right;
+  };
+
+  void compute_rectification(const EurocCameraSensor& cam1, const fs::path& yaml1) {
+    // p_c1 = T_BS1^-1 * T_BS0 * p_c0: the pose of cam0 in cam1's frame, as stereoRectify wants.
+    const Eigen::Isometry3d T_c1_c0 = cam1.T_BS.inverse() * cam0_.T_BS;
+    cv::Mat R, T;
+    cv::eigen2cv(Eigen::Matrix3d(T_c1_c0.rotation()), R);
+    cv::eigen2cv(Eigen::Vector3d(T_c1_c0.translation()), T);
+    const cv::Size size(cam0_.width, cam0_.height);
+    const cv::Mat K0 = camera_matrix(cam0_), K1 = camera_matrix(cam1);
+    const cv::Mat D0(cam0_.distortion), D1(cam1.distortion);
+    cv::Mat R1, R2, P1, P2, Q;
+    // alpha = 0 keeps only valid pixels, so no black borders produce spurious edges and corners.
+    cv::stereoRectify(K0, D0, K1, D1, size, R, T, R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0.0, size);
+    calib_.width = cam0_.width;
+    calib_.height = cam0_.height;
+    calib_.fx = P1.at<double>(0, 0);
+    calib_.fy = P1.at<double>(1, 1);
+    calib_.cx = P1.at<double>(0, 2);
+    calib_.cy = P1.at<double>(1, 2);
+    calib_.baseline = -P2.at<double>(0, 3) / P2.at<double>(0, 0);
+    // Baseline must come out positive: cam1 has to sit to the right of cam0.
+    validate_calibration(calib_, yaml1);
+    cv::cv2eigen(R1, R_rect_sensor_);
+    cv::initUndistortRectifyMap(K0, D0, R1, P1, size, CV_16SC2, map_left_[0], map_left_[1]);
+    cv::initUndistortRectifyMap(K1, D1, R2, P2, size, CV_16SC2, map_right_[0], map_right_[1]);
+  }
+
+  void pair_images(const std::vector<ImageEntry>& left, const std::vector<ImageEntry>& right) {
+    // The two cameras are hardware-triggered: equal stamps, with 1 ms of slack for clock jitter.
+    constexpr std::int64_t kToleranceNs = 1'000'000;
+    std::size_t j = 0;
+    for (const auto& l : left) {
+      while (j < right.size() && right[j].ns < l.ns - kToleranceNs) ++j;
+      if (j < right.size() && std::llabs(right[j].ns - l.ns) <= kToleranceNs) {
+        pairs_.push_back({l.ns, l.file, right[j].file});
+        ++j;
+      }
+    }
+    const std::size_t dropped = left.size() + right.size() - 2 * pairs_.size();
+    if (dropped > 0) spdlog::warn("{}: dropped {} unpaired images", root_.string(), dropped);
+    if (pairs_.empty()) throw InputError(root_.string(), "no left/right images with matching timestamps");
+  }
+
+  void load_ground_truth() {
+    const auto path = root_ / "state_groundtruth_estimate0" / "data.csv";
+    if (!fs::exists(path)) return;
+    const auto left = body_to_sensor(read_trajectory(path, TrajectoryFormat::kEuroc), cam0_.T_BS);
+    // Keep the samples that overlap the selected frames (half a frame of slack at both ends).
+    const double slack = 0.5 / std::max(fps(), 1.0);
+    Trajectory gt;
+    std::copy_if(left.begin(), left.end(), std::back_inserter(gt), [&](const StampedPose& sp) {
+      return sp.t >= timestamps_.front() - slack && sp.t <= timestamps_.back() + slack;
+    });
+    if (gt.empty()) {
+      spdlog::warn("{}: no ground truth overlaps the selected frames", path.string());
+      return;
+    }
+    gt_ = std::move(gt);
+    gt_path_ = path;
+  }
+
+  EurocCameraSensor cam0_;
+  std::array<cv::Mat, 2> map_left_, map_right_;
+  std::vector<Pair> pairs_;
+};
+
+}  // namespace
+
+std::unique_ptr<Dataset> open_euroc(const fs::path& mav0_dir, const DatasetOptions& options) {
+  return std::make_unique<EurocDataset>(fs::absolute(mav0_dir).lexically_normal(), options);
+}
+
+}  // namespace plslam::io::detail

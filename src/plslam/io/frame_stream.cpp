@@ -1,0 +1,75 @@
+#include "plslam/io/frame_stream.h"
+
+#include <spdlog/spdlog.h>
+
+#include "plslam/core/error.h"
+
+namespace plslam::io {
+
+FrameStream::FrameStream(const Dataset& dataset, std::size_t capacity)
+    : dataset_(dataset), capacity_(capacity == 0 ? 1 : capacity), worker_([this] { run(); }) {}
+
+FrameStream::~FrameStream() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  worker_.join();
+}
+
+void FrameStream::run() {
+  try {
+    for (std::size_t i = 0; i < dataset_.size(); ++i) {
+      {
+        std::unique_lock lock(mutex_);
+        cv_.wait(lock, [this] { return stop_ || queue_.size() < capacity_; });
+        if (stop_) break;
+      }
+      std::optional<StereoFrame> frame;
+      try {
+        frame = dataset_.load(i);
+      } catch (const InputError& e) {
+        spdlog::error("skipping frame {}: {}", i, e.what());
+      }
+      std::lock_guard lock(mutex_);
+      if (frame) {
+        queue_.push_back(std::move(*frame));
+      } else {
+        ++skipped_;
+      }
+      cv_.notify_all();
+    }
+  } catch (...) {
+    std::lock_guard lock(mutex_);
+    error_ = std::current_exception();
+  }
+  std::lock_guard lock(mutex_);
+  done_ = true;
+  cv_.notify_all();
+}
+
+std::optional<StereoFrame> FrameStream::next() {
+  std::unique_lock lock(mutex_);
+  cv_.wait(lock, [this] { return !queue_.empty() || done_; });
+  if (!queue_.empty()) {
+    StereoFrame f = std::move(queue_.front());
+    queue_.pop_front();
+    cv_.notify_all();
+    return f;
+  }
+  if (error_) std::rethrow_exception(error_);
+  return std::nullopt;
+}
+
+std::size_t FrameStream::skipped() const {
+  std::lock_guard lock(mutex_);
+  return skipped_;
+}
+
+std::size_t FrameStream::queued() const {
+  std::lock_guard lock(mutex_);
+  return queue_.size();
+}
+
+}  // namespace plslam::io

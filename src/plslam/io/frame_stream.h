@@ -1,0 +1,48 @@
+#pragma once
+// Streams a dataset's frames in order while a background thread decodes (and rectifies) the next
+// ones into a bounded queue: decoding overlaps processing, and memory stays flat however long
+// the sequence is.
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "plslam/io/dataset.h"
+
+namespace plslam::io {
+
+class FrameStream {
+ public:
+  explicit FrameStream(const Dataset& dataset, std::size_t capacity = 4);
+  ~FrameStream();
+  FrameStream(const FrameStream&) = delete;
+  FrameStream& operator=(const FrameStream&) = delete;
+
+  // The next frame, or nullopt at the end. A frame whose images cannot be decoded is reported
+  // once (error log naming the file) and skipped; other failures are rethrown here.
+  std::optional<StereoFrame> next();
+
+  std::size_t skipped() const;
+  std::size_t capacity() const { return capacity_; }
+  // Frames decoded but not yet taken (never more than capacity()).
+  std::size_t queued() const;
+
+ private:
+  void run();
+
+  const Dataset& dataset_;
+  const std::size_t capacity_;
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<StereoFrame> queue_;
+  std::size_t skipped_ = 0;
+  bool done_ = false;
+  bool stop_ = false;
+  std::exception_ptr error_;
+  std::thread worker_;  // last member: started after everything above is initialised
+};
+
+}  // namespace plslam::io
