@@ -9,8 +9,10 @@
 
 namespace plslam::synth {
 
-CameraPreset euroc_preset() { return {"euroc", 752, 480, 20.0, 458.0, 457.0, 367.5, 248.0, 0.11}; }
-CameraPreset kitti_preset() { return {"kitti", 1241, 376, 10.0, 718.856, 718.856, 607.19, 185.22, 0.54}; }
+// Square pixels and the principal point at the image centre: exactly what stereo rectification
+// of an ideal pair produces, so a reader that rectifies sees the images unchanged.
+CameraPreset euroc_preset() { return {"euroc", 752, 480, 20.0, 458.0, 458.0, 375.5, 239.5, 0.11}; }
+CameraPreset kitti_preset() { return {"kitti", 1241, 376, 10.0, 718.856, 718.856, 620.0, 187.5, 0.54}; }
 
 CameraPreset parse_preset(const std::string& name) {
   if (name == "euroc") return euroc_preset();
