@@ -37,7 +37,7 @@ void door(Scene& s, V2 a, V2 b, double at, int leaf, int frame) {
   const V2 dir = (b - a).normalized();
   const V2 c = a + dir * at;
   const V2 l = c - dir * 0.45, r = c + dir * 0.45;
-  vquad(s, l, r, 0.0, 2.05, leaf, 0, 0.004);
+  vquad(s, l, r, 0.0, 2.05, leaf, 0, 0.006);
   wall_box(s, l - dir * 0.07, l, 0.0, 2.12, 0.03, frame, frame);
   wall_box(s, r, r + dir * 0.07, 0.0, 2.12, 0.03, frame, frame);
   wall_box(s, l, r, 2.05, 2.12, 0.03, frame, frame);
@@ -70,7 +70,7 @@ Scene office(std::uint64_t seed) {
   const double X = 16, Y = 10, Z = 3;
   const int paint = s.add_texture(make_uniform(0.72f, 0.025f, seed + 1));
   const int paint2 = s.add_texture(make_uniform(0.55f, 0.025f, seed + 2));
-  const int floor = s.add_texture(make_tiles(512, seed + 3, 8, 0.42f, 0.07f));
+  const int floor = s.add_texture(make_tiles(512, seed + 3, 8, 0.42f, 0.12f));
   const int ceiling = s.add_texture(make_tiles(256, seed + 4, 4, 0.82f, 0.02f));
   const int wood = s.add_texture(make_wood(512, seed + 5, 0.55f));
   const int books = s.add_texture(make_books(512, seed + 6));
@@ -80,6 +80,10 @@ Scene office(std::uint64_t seed) {
   const int concrete = s.add_texture(make_noise(256, seed + 10, 0.6f, 0.1f, 8));
   const int door_tex = s.add_texture(make_wood(256, seed + 11, 0.38f));
   const int steel = s.add_texture(make_noise(128, seed + 12, 0.35f, 0.04f, 4));
+  const int outside = s.add_texture(make_facade(256, seed + 13, 3, 3));
+  const int cork = s.add_texture(make_noise(256, seed + 14, 0.5f, 0.12f, 32));
+  const int drawers = s.add_texture(make_tiles(64, seed + 15, 1, 0.5f, 0.0f));
+  const int radiator = s.add_texture(make_stripes(64, 8, 0.75f, 0.45f));
   std::vector<int> posters, pages;
   for (int k = 0; k < 8; ++k) posters.push_back(s.add_texture(make_poster(256, seed * 31 + 100 + k)));
   for (int k = 0; k < 4; ++k) pages.push_back(s.add_texture(make_text_page(512, seed * 31 + 200 + k)));
@@ -93,18 +97,28 @@ Scene office(std::uint64_t seed) {
   s.add_quad(V3(0, 0, 0), V3(X, 0, 0), V3(0, Y, 0), floor, 4.0);
   s.add_quad(V3(0, 0, Z), V3(0, Y, 0), V3(X, 0, 0), ceiling, 2.4);
   // Skirting along every wall.
-  wall_box(s, sw, se, 0, 0.09, 0.015, dark, dark);
-  wall_box(s, se, ne, 0, 0.09, 0.015, dark, dark);
-  wall_box(s, ne, nw, 0, 0.09, 0.015, dark, dark);
-  wall_box(s, nw, sw, 0, 0.09, 0.015, dark, dark);
+  vquad(s, sw, se, 0, 0.09, dark, 0, 0.01);
+  vquad(s, se, ne, 0, 0.09, dark, 0, 0.01);
+  vquad(s, ne, nw, 0, 0.09, dark, 0, 0.01);
+  vquad(s, nw, sw, 0, 0.09, dark, 0, 0.01);
 
   // South wall: windows (bright panels with frames) above desks.
   for (int k = 0; k < 3; ++k) {
     const double x0 = 2.0 + k * 5.0;
-    vquad(s, V2(x0, 0), V2(x0 + 2.4, 0), 1.0, 2.4, lamp, 0, 0.004, 1.2f);
+    vquad(s, V2(x0, 0), V2(x0 + 2.4, 0), 1.0, 2.4, outside, 3.0, 0.004, 1.3f);
+    wall_box(s, V2(x0 + 0.3, 0), V2(x0 + 2.1, 0), 0.15, 0.65, 0.08, radiator, paint, 0.5);
     wall_box(s, V2(x0 - 0.06, 0), V2(x0 + 2.46, 0), 0.94, 1.0, 0.12, paint, paint);
     wall_box(s, V2(x0 + 1.17, 0), V2(x0 + 1.23, 0), 1.0, 2.4, 0.05, paint, paint);
     wall_box(s, V2(x0 - 0.06, 0), V2(x0 + 2.46, 0), 2.4, 2.46, 0.05, paint, paint);
+  }
+  // Notice boards with pinned pages between the windows.
+  for (double x0 : {4.9, 9.9}) {
+    wall_box(s, V2(x0, 0), V2(x0 + 1.6, 0), 1.1, 2.1, 0.02, cork, wood);
+    for (int k = 0; k < 6; ++k) {
+      const double px = x0 + 0.08 + (k % 3) * 0.5 + rng.uniform(-0.03, 0.03);
+      const double pz = 1.17 + (k / 3) * 0.45 + rng.uniform(-0.03, 0.03);
+      vquad(s, V2(px, 0), V2(px + 0.3, 0), pz, pz + 0.38, k % 2 ? pages[k % 4] : posters[k], 0, 0.022);
+    }
   }
   // Desks with monitors and papers along the south and north walls.
   auto desk = [&](V2 a, V2 b) {
@@ -118,6 +132,19 @@ Scene office(std::uint64_t seed) {
     const V2 m = a + (b - a) * rng.uniform(0.3, 0.6) + n * 0.15;
     wall_box(s, m, m + d * 0.55, 0.8, 1.15, 0.04, dark, dark);  // monitor
     wall_box(s, m + d * 0.25, m + d * 0.3, 0.76, 0.8, 0.04, steel, steel);
+    // An office chair in front of the desk and a drawer unit beside it.
+    const V2 c = a + (b - a) * rng.uniform(0.35, 0.65) + n * 1.0;
+    s.add_box(V3(c.x() - 0.25, c.y() - 0.25, 0.42), V3(c.x() + 0.25, c.y() + 0.25, 0.5), dark, steel);
+    s.add_box(V3(c.x() - 0.03, c.y() - 0.03, 0.05), V3(c.x() + 0.03, c.y() + 0.03, 0.42), steel, steel);
+    s.add_box(V3(c.x() - 0.3, c.y() - 0.3, 0.0), V3(c.x() + 0.3, c.y() + 0.3, 0.05), dark, dark);
+    const V2 back = c + n * 0.22;
+    s.add_box(V3(std::min(back.x(), back.x() + n.x() * 0.06) - std::abs(d.x()) * 0.22,
+                 std::min(back.y(), back.y() + n.y() * 0.06) - std::abs(d.y()) * 0.22, 0.55),
+              V3(std::max(back.x(), back.x() + n.x() * 0.06) + std::abs(d.x()) * 0.22,
+                 std::max(back.y(), back.y() + n.y() * 0.06) + std::abs(d.y()) * 0.22, 1.05),
+              dark, dark);
+    const V2 dr = b + d * 0.05;
+    wall_box(s, dr, dr + d * 0.45, 0, 0.65, 0.6, drawers, steel);
     const V2 p = a + (b - a) * 0.15 + n * 0.35;
     s.add_quad(V3(p.x(), p.y(), 0.761), V3(d.x() * 0.3, d.y() * 0.3, 0), V3(n.x() * 0.21, n.y() * 0.21, 0),
                pages[rng.integer(0, 3)]);
@@ -184,10 +211,11 @@ Scene corridor(std::uint64_t seed) {
   Scene s;
   s.kind = SceneKind::kCorridor;
   const double X = 20, Y = 12, Z = 2.6, w = 2.4;
-  const int paint = s.add_texture(make_uniform(0.7f, 0.012f, seed + 1));
+  const int paint = s.add_texture(make_uniform(0.72f, 0.012f, seed + 1));
   const int paint2 = s.add_texture(make_uniform(0.6f, 0.012f, seed + 2));
+  const int lower = s.add_texture(make_uniform(0.42f, 0.012f, seed + 10));
   const int floor = s.add_texture(make_noise(256, seed + 3, 0.4f, 0.03f, 2));
-  const int ceiling = s.add_texture(make_uniform(0.85f, 0.01f, seed + 4));
+  const int ceiling = s.add_texture(make_tiles(256, seed + 4, 4, 0.85f, 0.01f));  // 0.6 m grid
   const int skirting = s.add_texture(make_uniform(0.22f, 0.01f, seed + 5));
   const int door_tex = s.add_texture(make_uniform(0.38f, 0.015f, seed + 6));
   const int frame = s.add_texture(make_uniform(0.9f, 0.01f, seed + 7));
@@ -197,19 +225,28 @@ Scene corridor(std::uint64_t seed) {
   const V2 o[4] = {V2(0, 0), V2(X, 0), V2(X, Y), V2(0, Y)};
   const V2 in[4] = {V2(w, w), V2(X - w, w), V2(X - w, Y - w), V2(w, Y - w)};
   s.add_quad(V3(0, 0, 0), V3(X, 0, 0), V3(0, Y, 0), floor, 3.0);
-  s.add_quad(V3(0, 0, Z), V3(0, Y, 0), V3(X, 0, 0), ceiling, 2.0);
+  s.add_quad(V3(0, 0, Z), V3(0, Y, 0), V3(X, 0, 0), ceiling, 2.4);
   for (int k = 0; k < 4; ++k) {
     const V2 a = o[k], b = o[(k + 1) % 4];
     const V2 ia = in[(k + 1) % 4], ib = in[k];  // inner block walls face outwards
     vquad(s, a, b, 0, Z, paint);
     vquad(s, ia, ib, 0, Z, paint2);
-    wall_box(s, a, b, 0, 0.1, 0.015, skirting, skirting);
-    wall_box(s, ia, ib, 0, 0.1, 0.015, skirting, skirting);
-    wall_box(s, a, b, 0.95, 1.0, 0.012, rail, rail);  // dado rail: a long line, no corners
+    // Skirting, a darker lower wall (wainscot) and a dado rail: long lines, no corners. Flat
+    // bands slightly off the wall (thin box tops would alias into dashes).
+    for (const auto& [p, q] : {std::pair{a, b}, std::pair{ia, ib}}) {
+      vquad(s, p, q, 0, 0.1, skirting, 0, 0.004);
+      vquad(s, p, q, 0.1, 0.95, lower, 0, 0.002);
+      vquad(s, p, q, 0.95, 1.0, rail, 0, 0.004);
+    }
     const double len = (b - a).norm();
     for (double d = 3.0; d < len - 2.0; d += 5.5) door(s, a, b, d, door_tex, frame);
     const double ilen = (ib - ia).norm();
     for (double d = 4.5; d < ilen - 2.0; d += 6.0) door(s, ia, ib, d, door_tex, frame);
+    // Shallow pilasters between the doors: long vertical edges, corners only at floor level.
+    for (double d = 1.2; d < len - 1.0; d += 5.5) {
+      const V2 p = a + (b - a) * (d / len);
+      wall_box(s, p, p + (b - a) * (0.35 / len), 0, Z, 0.08, paint, paint);
+    }
   }
   // Ceiling light panels along the centre line, and their light.
   const V2 c[4] = {V2(w / 2, w / 2), V2(X - w / 2, w / 2), V2(X - w / 2, Y - w / 2), V2(w / 2, Y - w / 2)};
@@ -247,6 +284,9 @@ Scene street(std::uint64_t seed) {
     facades.push_back(s.add_texture(make_facade(512, seed * 17 + 300 + k, 4, 4)));
   for (int k = 0; k < 6; ++k) cars.push_back(s.add_texture(make_car(256, seed * 17 + 400 + k)));
   const int glass = s.add_texture(make_uniform(0.12f, 0.02f, seed + 6));
+  std::vector<int> signs, shop;
+  for (int k = 0; k < 4; ++k) signs.push_back(s.add_texture(make_poster(256, seed * 17 + 500 + k)));
+  for (int k = 0; k < 2; ++k) shop.push_back(s.add_texture(make_text_page(256, seed * 17 + 600 + k)));
 
   s.add_quad(V3(-40, -40, 0), V3(X + 80, 0, 0), V3(0, Y + 80, 0), asphalt, 8.0);
   // Inner and outer sidewalks (kerb height 0.15) and the building rows behind them.
@@ -270,6 +310,13 @@ Scene street(std::uint64_t seed) {
       const V3 hi(std::max(p0.x(), p2.x()), std::max(p0.y(), p2.y()), h);
       const bool brick = rng.uniform() < 0.25;
       s.add_box(lo, hi, brick ? bricks : facades[rng.integer(0, 4)], pole, brick ? 3.0 : 12.0);
+      // Ground floor towards the road: a shop sign, a shop window and a door.
+      // e runs along the front so that quads from -e to +e face the road (-outward).
+      const V2 m = p0 + d * (wdt * 0.5), e(-outward.y(), outward.x());
+      const double sw = std::min(6.0, wdt * 0.6);
+      vquad(s, m - e * (sw / 2), m + e * (sw / 2), 3.0, 3.9, signs[rng.integer(0, 3)], 0, 0.03);
+      vquad(s, m - e * (sw / 2), m - e * 0.5, 0.4, 2.6, shop[rng.integer(0, 1)], 0, 0.02);
+      vquad(s, m + e * 0.4, m + e * 1.5, 0.15, 2.4, glass, 0, 0.02);
       pos += wdt + (rng.uniform() < 0.3 ? rng.uniform(2, 5) : 0.0);
     }
   };
@@ -322,9 +369,9 @@ Scene street(std::uint64_t seed) {
       q.origin += q.v;
       q.v = -q.v;
     }
-  s.ambient = 0.55;
+  s.ambient = 1.0;
   s.sun_direction = V3(0.45, 0.3, 0.84).normalized();
-  s.sun_power = 0.55;
+  s.sun_power = 0.5;
   s.background = 1.05f;
   s.path = rounded_rect(V2(0, 0), V2(X, Y), 12.0);
   s.camera_height = 1.65;

@@ -110,6 +110,15 @@ Texture make_uniform(float value, float noise, std::uint64_t seed) {
   return make_noise(128, seed, value, noise, 4);
 }
 
+Texture make_stripes(int size, int stripes, float a, float b) {
+  Texture t = blank(size, true);
+  const int period = size / stripes;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) at(t, x, y) = (x % period) < period * 2 / 3 ? a : b;
+  finish(t);
+  return t;
+}
+
 Texture make_bricks(int size, std::uint64_t seed, float brick, float mortar) {
   Texture t = blank(size, true);
   Rng rng(seed);

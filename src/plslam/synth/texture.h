@@ -46,6 +46,7 @@ Texture make_poster(int size, std::uint64_t seed);         // geometric shapes o
 Texture make_books(int size, std::uint64_t seed);          // shelf of book spines
 Texture make_facade(int size, std::uint64_t seed, int cols, int rows);  // windows on plaster
 Texture make_car(int size, std::uint64_t seed);            // car-side-like paint with windows
+Texture make_stripes(int size, int stripes, float a, float b);  // vertical ribs (radiators)
 Texture make_uniform(float value, float noise, std::uint64_t seed);     // painted, low texture
 
 }  // namespace plslam::synth
