@@ -45,21 +45,29 @@ void door(Scene& s, V2 a, V2 b, double at, int leaf, int frame) {
   wall_box(s, h - dir * 0.12, h, 1.0, 1.04, 0.06, frame, frame);
 }
 
-// Control polygon for a closed path around a rectangle, with extra points near the corners so
-// the B-spline stays on the straights and rounds each corner over about `round` metres.
-std::vector<V2> rounded_rect(V2 lo, V2 hi, double round) {
+// Dense control polygon for a closed path around a rectangle (counter-clockwise), with corners
+// rounded to `radius` metres so that the B-spline's curvature, and with it the yaw rate, stays
+// bounded. Starts in the middle of the first straight, so the first frames are not in a turn.
+std::vector<V2> rounded_rect(V2 lo, V2 hi, double radius) {
   const V2 c[4] = {lo, V2(hi.x(), lo.y()), hi, V2(lo.x(), hi.y())};
   std::vector<V2> out;
   for (int k = 0; k < 4; ++k) {
-    const V2 p = c[k], n = c[(k + 1) % 4];
-    const V2 d = (n - p).normalized();
+    const V2 p = c[k], n = c[(k + 1) % 4], next = c[(k + 2) % 4];
+    const V2 d = (n - p).normalized(), dout = (next - n).normalized();
     const double len = (n - p).norm();
-    const int steps = std::max(2, static_cast<int>((len - 2 * round) / 2.0));
-    out.push_back(p);
-    for (int i = 0; i <= steps; ++i) out.push_back(p + d * (round + (len - 2 * round) * i / steps));
+    const int steps = std::max(2, static_cast<int>(std::ceil((len - 2 * radius) / std::max(0.5, radius / 2))));
+    for (int i = 0; i < steps; ++i) out.push_back(p + d * (radius + (len - 2 * radius) * i / steps));
+    const V2 centre = n - d * radius + dout * radius;
+    constexpr int kArc = 9;  // 10 degrees per control point
+    for (int j = 0; j < kArc; ++j) {
+      const double th = 1.5707963267948966 * j / kArc;
+      out.push_back(centre + radius * (-dout * std::cos(th) + d * std::sin(th)));
+    }
   }
-  // Start the loop in the middle of the first straight so the first frames are not in a turn.
-  std::rotate(out.begin(), out.begin() + 2, out.end());
+  // Begin in the middle of the first straight.
+  const std::size_t first_straight = static_cast<std::size_t>(
+      std::max(2, static_cast<int>(std::ceil(((c[1] - c[0]).norm() - 2 * radius) / std::max(0.5, radius / 2)))));
+  std::rotate(out.begin(), out.begin() + first_straight / 2, out.end());
   return out;
 }
 
@@ -199,7 +207,7 @@ Scene office(std::uint64_t seed) {
     }
   s.ambient = 0.35;
   s.background = 0.5f;
-  s.path = rounded_rect(V2(2.6, 2.3), V2(13.4, 7.7), 1.6);
+  s.path = rounded_rect(V2(2.6, 2.3), V2(13.4, 7.7), 1.4);
   s.camera_height = 1.45;
   s.nominal_speed = 1.0;
   s.max_speed = 1.5;
@@ -210,7 +218,7 @@ Scene office(std::uint64_t seed) {
 Scene corridor(std::uint64_t seed) {
   Scene s;
   s.kind = SceneKind::kCorridor;
-  const double X = 20, Y = 12, Z = 2.6, w = 2.4;
+  const double X = 20, Y = 12, Z = 2.6, w = 2.8;
   const int paint = s.add_texture(make_uniform(0.72f, 0.012f, seed + 1));
   const int paint2 = s.add_texture(make_uniform(0.6f, 0.012f, seed + 2));
   const int lower = s.add_texture(make_uniform(0.42f, 0.012f, seed + 10));
@@ -242,8 +250,17 @@ Scene corridor(std::uint64_t seed) {
     for (double d = 3.0; d < len - 2.0; d += 5.5) door(s, a, b, d, door_tex, frame);
     const double ilen = (ib - ia).norm();
     for (double d = 4.5; d < ilen - 2.0; d += 6.0) door(s, ia, ib, d, door_tex, frame);
+    // A window near the end of each leg of the ring, where the walker turns towards it.
+    {
+      const V2 dir = (b - a) / len;
+      for (const V2& w0 : {V2(b - dir * 1.8), V2(a + dir * 0.5)}) {
+        const V2 w1 = w0 + dir * 1.1;
+        vquad(s, w0, w1, 1.0, 2.1, lamp, 0, 0.006, 0.8f);
+        wall_box(s, w0 - dir * 0.05, w1 + dir * 0.05, 0.94, 1.0, 0.1, frame, frame);
+      }
+    }
     // Shallow pilasters between the doors: long vertical edges, corners only at floor level.
-    for (double d = 1.2; d < len - 1.0; d += 5.5) {
+    for (double d = 2.0; d < len - 2.0; d += 5.5) {
       const V2 p = a + (b - a) * (d / len);
       wall_box(s, p, p + (b - a) * (0.35 / len), 0, Z, 0.08, paint, paint);
     }
@@ -256,12 +273,12 @@ Scene corridor(std::uint64_t seed) {
     for (double d = 1.5; d < len - 1.0; d += 3.5) {
       const V2 p = a + (b - a) * (d / len);
       s.add_quad(V3(p.x() - 0.3, p.y() - 0.3, Z - 0.005), V3(0, 0.6, 0), V3(0.6, 0, 0), lamp, 0, 1.5f);
-      s.lights.push_back({V3(p.x(), p.y(), Z - 0.2), 0.3, 2.5});
+      s.lights.push_back({V3(p.x(), p.y(), Z - 0.2), 0.4, 2.5});
     }
   }
   s.ambient = 0.35;
   s.background = 0.5f;
-  s.path = rounded_rect(c[0], c[2], 1.6);
+  s.path = rounded_rect(c[0], c[2], 1.4);
   s.camera_height = 1.45;
   s.nominal_speed = 1.0;
   s.max_speed = 1.5;
@@ -373,7 +390,7 @@ Scene street(std::uint64_t seed) {
   s.sun_direction = V3(0.45, 0.3, 0.84).normalized();
   s.sun_power = 0.5;
   s.background = 1.05f;
-  s.path = rounded_rect(V2(0, 0), V2(X, Y), 12.0);
+  s.path = rounded_rect(V2(0, 0), V2(X, Y), 11.0);
   s.camera_height = 1.65;
   s.nominal_speed = 8.0;
   s.max_speed = 15.0;
