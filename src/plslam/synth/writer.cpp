@@ -164,12 +164,13 @@ void write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat forma
       body.push_back({t, seq.left_pose(i) * T_BS0.inverse()});  // T_wb = T_wc * T_cb
     }
     io::write_trajectory(mav / "state_groundtruth_estimate0" / "data.csv", body, io::TrajectoryFormat::kEuroc);
-    write_ground_truth_extras(seq, mav / "synth", Eigen::Isometry3d::Identity(), times, "euroc world (z up)");
     render_all(seq, progress, threads, [&](std::size_t i, const StereoImages& im) {
       const std::string name = fmt::format("{}.png", euroc_timestamp_ns(seq, i));
       write_png(mav / "cam0" / "data" / name, im.left);
       write_png(mav / "cam1" / "data" / name, im.right);
     });
+    // Last, so that synth/synth.json marks a complete sequence.
+    write_ground_truth_extras(seq, mav / "synth", Eigen::Isometry3d::Identity(), times, "euroc world (z up)");
     return;
   }
   const fs::path sdir = dir / "sequences" / "00";
@@ -197,11 +198,11 @@ void write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat forma
   for (std::size_t i = 0; i < n; ++i) poses.push_back({times[i], T_0w * seq.left_pose(i)});
   poses[0].T = Eigen::Isometry3d::Identity();  // exactly, not up to rounding
   io::write_trajectory(dir / "poses" / "00.txt", poses, io::TrajectoryFormat::kKitti);
-  write_ground_truth_extras(seq, sdir / "synth", T_0w, times, "kitti first left camera");
   render_all(seq, progress, threads, [&](std::size_t i, const StereoImages& im) {
     write_png(sdir / "image_0" / fmt::format("{:06d}.png", i), im.left);
     write_png(sdir / "image_1" / fmt::format("{:06d}.png", i), im.right);
   });
+  write_ground_truth_extras(seq, sdir / "synth", T_0w, times, "kitti first left camera");
 }
 
 }  // namespace plslam::synth

@@ -13,7 +13,8 @@
 //   synth/segments_3d.txt   "x1 y1 z1 x2 y2 z2" per line: every straight scene edge
 //   synth/points_3d.txt     "x y z" per line: surface sample points
 //   synth/left_camera.tum   TUM poses of the left camera (T_world_left) at the image times
-//   synth/synth.json        the options (scene, preset, seed, loop, ...) and the frame used
+//   synth/synth.json        the options (scene, preset, seed, loop, ...) and the frame used;
+//                           written last, so its presence marks a complete sequence
 // All synth/ coordinates are in the frame of that layout's ground truth: the EuRoC world
 // (z up) or, for KITTI, the first left camera.
 #include <filesystem>
