@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 namespace plslam::synth {
 
@@ -14,7 +15,9 @@ constexpr float kEdgeEps = 1e-5f;
 // Rotated-grid 4x supersampling pattern (offsets from the pixel centre).
 constexpr float kSub[4][2] = {{-0.125f, -0.375f}, {0.375f, -0.125f}, {0.125f, 0.375f}, {-0.375f, 0.125f}};
 
-inline float bilinear(const TextureLevel& lv, bool repeat, float u, float v) {
+template <bool kRepeat>
+inline float bilinear_t(const TextureLevel& lv, float u, float v) {
+  constexpr bool repeat = kRepeat;
   const int n = lv.size;
   const float uu = u - 0.5f, vv = v - 0.5f;
   // floor() without a libm call: truncate, then step down for negatives.
@@ -24,7 +27,7 @@ inline float bilinear(const TextureLevel& lv, bool repeat, float u, float v) {
   const float fu = static_cast<float>(iu), fv = static_cast<float>(iv);
   const float au = uu - fu, av = vv - fv;
   int x0, x1, y0, y1;
-  if (repeat) {
+  if constexpr (repeat) {
     const int m = n - 1;
     x0 = iu & m;
     y0 = iv & m;
@@ -41,6 +44,10 @@ inline float bilinear(const TextureLevel& lv, bool repeat, float u, float v) {
   const float top = r0[x0] + (r0[x1] - r0[x0]) * au;
   const float bot = r1[x0] + (r1[x1] - r1[x0]) * au;
   return top + (bot - top) * av;
+}
+
+inline float bilinear(const TextureLevel& lv, bool repeat, float u, float v) {
+  return repeat ? bilinear_t<true>(lv, u, v) : bilinear_t<false>(lv, u, v);
 }
 
 }  // namespace
@@ -225,14 +232,19 @@ void Renderer::shade_run(int qi, int y, int x0, int x1, float* out) const {
     const float scale = n0 / static_cast<float>(1 << first.level);
     const float su = q.repeat_u * scale, sv = q.repeat_v * scale;
     const float dl = (next.light - first.light) / static_cast<float>(xe - xb);
-    float light = first.light;
-    for (int x = xb; x < xe; ++x, light += dl) {
-      const float fx = static_cast<float>(x);
-      const float iw = 1.0f / (v.w.x() * fx + wr);
-      const float s = std::clamp((v.a.x() * fx + ar) * iw, 0.0f, 1.0f);
-      const float t = std::clamp((v.b.x() * fx + br) * iw, 0.0f, 1.0f);
-      out[x] = light * bilinear(lv, tex.repeat, s * su, t * sv);
-    }
+    auto span = [&](auto repeat_tag) {
+      constexpr bool kRepeat = decltype(repeat_tag)::value;
+      float light = first.light;
+      for (int x = xb; x < xe; ++x, light += dl) {
+        const float fx = static_cast<float>(x);
+        const float iw = 1.0f / (v.w.x() * fx + wr);
+        const float s = std::clamp((v.a.x() * fx + ar) * iw, 0.0f, 1.0f);
+        const float t = std::clamp((v.b.x() * fx + br) * iw, 0.0f, 1.0f);
+        out[x] = light * bilinear_t<kRepeat>(lv, s * su, t * sv);
+      }
+    };
+    if (tex.repeat) span(std::true_type{});
+    else span(std::false_type{});
   }
 }
 
