@@ -9,10 +9,10 @@ bash scripts/install-deps.sh
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD_DIR" -j"$(nproc)"
 
-# 460 frames at 20 Hz walk the 31 m office loop once (at 1.4 m/s) and return to the start.
+# 480 frames at 20 Hz walk the 31 m office loop once (at 1.35 m/s) and return to the start.
 DATA="$BUILD_DIR/data/office_loop"
 if [ ! -f "$DATA/mav0/synth/synth.json" ]; then  # synth.json is written last: complete data
   rm -rf "$DATA"
-  "$BUILD_DIR/plslam" synth --out "$DATA" --scene office --preset euroc --frames 460 --loop --seed 1
+  "$BUILD_DIR/plslam" synth --out "$DATA" --scene office --preset euroc --frames 480 --loop --seed 1
 fi
 "$BUILD_DIR/plslam" info "$DATA"

@@ -174,7 +174,11 @@ Scene office(std::uint64_t seed) {
   wall_box(s, V2(0, 8.65), V2(0, 5.75), 0.85, 0.9, 0.06, steel, steel);
   door(s, nw, sw, 6.0, door_tex, dark);
   vquad(s, V2(0, 3.0), V2(0, 2.0), 1.2, 2.5, posters[2], 0, 0.004);
-  vquad(s, V2(0, 1.6), V2(0, 0.8), 1.4, 2.4, posters[3], 0, 0.004);
+  // Book shelves in the south-west corner (the walker faces this corner while turning).
+  wall_box(s, V2(1.45, 0), V2(0.05, 0), 0, 2.0, -0.4, wood, wood, 1.2);
+  vquad(s, V2(0.05, 0.4), V2(1.45, 0.4), 0.05, 1.95, books, 0, 0.002);
+  wall_box(s, V2(0, 2.0), V2(0, 0.6), 0, 2.0, 0.4, wood, wood, 1.2);
+  vquad(s, V2(0.4, 2.0), V2(0.4, 0.6), 0.05, 1.95, books, 0, 0.002);
   // East (brick) wall: posters and a tall cabinet.
   vquad(s, V2(X, 1.5), V2(X, 2.7), 1.1, 2.5, posters[4], 0, 0.004);
   vquad(s, V2(X, 6.8), V2(X, 8.2), 1.0, 2.3, posters[5], 0, 0.004);
@@ -207,7 +211,7 @@ Scene office(std::uint64_t seed) {
     }
   s.ambient = 0.35;
   s.background = 0.5f;
-  s.path = rounded_rect(V2(2.6, 2.3), V2(13.4, 7.7), 1.4);
+  s.path = rounded_rect(V2(2.4, 2.2), V2(13.6, 7.8), 1.4);
   s.camera_height = 1.45;
   s.nominal_speed = 1.0;
   s.max_speed = 1.5;
