@@ -57,6 +57,7 @@ struct Scene {
   double nominal_speed = 1.0;
   double max_speed = 1.5;
   bool vehicle = false;  // car motion (no bobbing, no pitch/roll wobble)
+  double look_around = 0.22;  // amplitude (rad) of the walker's slow yaw away from the path
 
   int add_texture(Texture t);
   // Adds a quad with texture repeats derived from the physical size and `texel_m` metres per

@@ -226,7 +226,7 @@ Scene corridor(std::uint64_t seed) {
   const int paint = s.add_texture(make_uniform(0.72f, 0.012f, seed + 1));
   const int paint2 = s.add_texture(make_uniform(0.6f, 0.012f, seed + 2));
   const int lower = s.add_texture(make_uniform(0.42f, 0.012f, seed + 10));
-  const int floor = s.add_texture(make_noise(256, seed + 3, 0.4f, 0.03f, 2));
+  const int floor = s.add_texture(make_tiles(256, seed + 3, 4, 0.4f, 0.015f));  // 0.6 m vinyl tiles
   const int ceiling = s.add_texture(make_tiles(256, seed + 4, 4, 0.85f, 0.01f));  // 0.6 m grid
   const int skirting = s.add_texture(make_uniform(0.22f, 0.01f, seed + 5));
   const int door_tex = s.add_texture(make_uniform(0.38f, 0.015f, seed + 6));
@@ -236,7 +236,7 @@ Scene corridor(std::uint64_t seed) {
 
   const V2 o[4] = {V2(0, 0), V2(X, 0), V2(X, Y), V2(0, Y)};
   const V2 in[4] = {V2(w, w), V2(X - w, w), V2(X - w, Y - w), V2(w, Y - w)};
-  s.add_quad(V3(0, 0, 0), V3(X, 0, 0), V3(0, Y, 0), floor, 3.0);
+  s.add_quad(V3(0, 0, 0), V3(X, 0, 0), V3(0, Y, 0), floor, 2.4);
   s.add_quad(V3(0, 0, Z), V3(0, Y, 0), V3(X, 0, 0), ceiling, 2.4);
   for (int k = 0; k < 4; ++k) {
     const V2 a = o[k], b = o[(k + 1) % 4];
@@ -283,6 +283,7 @@ Scene corridor(std::uint64_t seed) {
   s.ambient = 0.35;
   s.background = 0.5f;
   s.path = rounded_rect(c[0], c[2], 1.4);
+  s.look_around = 0.08;  // in a corridor one looks along it, not at the walls
   s.camera_height = 1.45;
   s.nominal_speed = 1.0;
   s.max_speed = 1.5;

@@ -23,7 +23,7 @@ Eigen::Matrix3d camera_rotation(double yaw, double pitch, double roll) {
 }
 
 CameraPath::CameraPath(const Scene& scene, double speed, std::uint64_t seed)
-    : speed_(speed), height_(scene.camera_height), vehicle_(scene.vehicle) {
+    : speed_(speed), height_(scene.camera_height), vehicle_(scene.vehicle), look_around_(scene.look_around) {
   const auto& P = scene.path;
   const int n = static_cast<int>(P.size());
   constexpr int kPerSegment = 200;
@@ -78,7 +78,7 @@ Eigen::Isometry3d CameraPath::pose(double t) const {
     const Eigen::Vector2d lateral(-std::sin(h), std::cos(h));
     p += lateral * (0.03 * std::sin(kTwoPi * 0.9 * t + phase_[0]));
     z = height_ + 0.02 * std::sin(kTwoPi * 1.8 * t + phase_[1]);
-    yaw = h + 0.22 * std::sin(kTwoPi * t / 6.1 + phase_[2]);
+    yaw = h + look_around_ * std::sin(kTwoPi * t / 6.1 + phase_[2]);
     pitch = -0.06 + 0.05 * std::sin(kTwoPi * t / 4.3 + phase_[3]);
     roll = 0.03 * std::sin(kTwoPi * t / 3.7 + phase_[4]);
   }

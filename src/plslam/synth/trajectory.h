@@ -30,6 +30,7 @@ class CameraPath {
   double speed_;
   double height_;
   bool vehicle_;
+  double look_around_;
   double phase_[6];
 };
 
