@@ -56,7 +56,8 @@ Eigen::Matrix3d nearest_rotation(const Eigen::Matrix3d& M) {
 void check_increasing(const Trajectory& traj, const std::vector<NumericRow>& rows,
                       const std::filesystem::path& path) {
   for (std::size_t i = 1; i < traj.size(); ++i) {
-    if (!(traj[i].t > traj[i - 1].t)) {
+    // Repeated stamps are tolerated, as evo does: real files have them (evo's own V102.txt).
+    if (!(traj[i].t >= traj[i - 1].t)) {
       throw InputError(path.string(), where(rows[i].line) +
                                           fmt::format("timestamp {} is not after {}", traj[i].t, traj[i - 1].t));
     }
@@ -109,7 +110,7 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& path) {
 }
 
 Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat format,
-                           const std::vector<double>* kitti_times) {
+                           const std::vector<double>* kitti_times, KittiRotation kitti_rotation) {
   const auto rows = read_numeric_rows(path);
   if (rows.empty()) throw InputError(path.string(), "empty trajectory file");
   Trajectory traj;
@@ -149,7 +150,7 @@ Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat f
           throw InputError(path.string(), where(r.line) + "rotation part is not a rotation");
         }
         Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-        T.linear() = nearest_rotation(M);
+        T.linear() = kitti_rotation == KittiRotation::kAsWritten ? M : nearest_rotation(M);
         T.translation() = p;
         traj.push_back({kitti_times ? (*kitti_times)[i] : static_cast<double>(i), T});
       }

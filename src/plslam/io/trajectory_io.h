@@ -14,6 +14,11 @@ namespace plslam::io {
 
 enum class TrajectoryFormat { kTum, kKitti, kEuroc };
 
+// KITTI files hold rotation blocks with 6-9 digits. kNearestRotation projects each onto SO(3);
+// kAsWritten keeps the 3x3 block as read, which is what evo and the KITTI devkit evaluate (their
+// numbers differ in the 5th digit otherwise).
+enum class KittiRotation { kNearestRotation, kAsWritten };
+
 const char* to_string(TrajectoryFormat f);
 // Parses "tum", "kitti", "euroc"; throws InputError otherwise.
 TrajectoryFormat parse_trajectory_format(const std::string& name);
@@ -25,9 +30,10 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& path);
 
 // Reads a trajectory. KITTI files have no times: `kitti_times` supplies them when given (same
 // length required), otherwise frame i gets t = i. Any malformed line, wrong column count, NaN or
-// non-increasing timestamp throws InputError naming the file and line.
+// decreasing timestamp throws InputError naming the file and line (equal stamps are accepted).
 Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat format,
-                           const std::vector<double>* kitti_times = nullptr);
+                           const std::vector<double>* kitti_times = nullptr,
+                           KittiRotation kitti_rotation = KittiRotation::kNearestRotation);
 
 // Writes with full double precision, so reading the file back gives the same poses to 1e-9.
 void write_trajectory(const std::filesystem::path& path, const Trajectory& trajectory,

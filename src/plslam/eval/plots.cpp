@@ -1,0 +1,145 @@
+#include "plslam/eval/plots.h"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "plslam/core/error.h"
+#include "plslam/eval/chart.h"
+
+namespace plslam::eval {
+namespace {
+
+// matplotlib's tab10, in BGR.
+const cv::Scalar kBlue(180, 119, 31), kOrange(14, 127, 255), kGreen(44, 160, 44),
+    kRed(40, 39, 214), kPurple(189, 103, 148), kGrey(90, 90, 90);
+
+constexpr std::array<const char*, 3> kAxisNames = {"x", "y", "z"};
+
+void save(const cv::Mat& img, const std::filesystem::path& path) {
+  if (!cv::imwrite(path.string(), img)) throw InputError(path.string(), "cannot write the plot");
+}
+
+void add_statistic_lines(Chart& c, const ErrorStatistics& s, const char* unit) {
+  c.add_hline(s.rmse, {kRed, 2, false}, fmt::format("rmse {:.4g} {}", s.rmse, unit));
+  c.add_hline(s.mean, {kGreen, 2, true}, fmt::format("mean {:.4g} {}", s.mean, unit));
+  c.add_hline(s.median, {kPurple, 2, true}, fmt::format("median {:.4g} {}", s.median, unit));
+}
+
+std::string time_axis(const PlotOptions& o) { return o.x_is_frame ? "frame" : "time [s]"; }
+
+double time_of(const Trajectory& gt, std::size_t i, const PlotOptions& o) {
+  return o.x_is_frame ? gt[i].t : gt[i].t - gt.front().t;
+}
+
+std::string alignment_text(const EvalResult& r) {
+  switch (r.align) {
+    case AlignMode::kNone: return "no alignment";
+    case AlignMode::kSE3: return "SE(3) alignment";
+    case AlignMode::kSim3: return fmt::format("Sim(3) alignment, scale {:.4f}", r.alignment.s);
+  }
+  return "";
+}
+
+}  // namespace
+
+std::pair<int, int> top_view_axes(const Trajectory& gt) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const auto& p : gt) {
+    lo = lo.cwiseMin(p.T.translation());
+    hi = hi.cwiseMax(p.T.translation());
+  }
+  Eigen::Index dropped = 2;
+  if (!gt.empty()) (hi - lo).minCoeff(&dropped);
+  if (dropped == 0) return {1, 2};
+  if (dropped == 1) return {0, 2};
+  return {0, 1};
+}
+
+std::vector<std::filesystem::path> write_plots(const EvalResult& r, const std::filesystem::path& dir,
+                                               const PlotOptions& options) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError(dir.string(), "cannot create the plot folder: " + ec.message());
+  std::vector<std::filesystem::path> written;
+
+  {  // Top view.
+    const auto [a, b] = top_view_axes(r.gt);
+    std::vector<cv::Point2d> gt_pts, est_pts;
+    for (const auto& p : r.gt) gt_pts.emplace_back(p.T.translation()(a), p.T.translation()(b));
+    for (const auto& p : r.est) est_pts.emplace_back(p.T.translation()(a), p.T.translation()(b));
+    Chart c;
+    c.set_title(fmt::format("Trajectory, top view ({}-{} plane), {}", kAxisNames[a], kAxisNames[b],
+                            alignment_text(r)));
+    c.set_xlabel(fmt::format("{} [m]", kAxisNames[a]));
+    c.set_ylabel(fmt::format("{} [m]", kAxisNames[b]));
+    c.set_equal_aspect(true);
+    const cv::Point2d start = gt_pts.front();
+    c.add_line(std::move(gt_pts), {kGrey, 2, false}, "ground truth");
+    c.add_line(std::move(est_pts), {kBlue, 2, false}, "estimate");
+    c.add_marker(start, cv::Scalar(0, 0, 0), "start");
+    cv::Mat img(900, 900, CV_8UC3);
+    c.draw(img);
+    written.push_back(dir / "trajectory.png");
+    save(img, written.back());
+  }
+
+  {  // APE over time.
+    std::vector<cv::Point2d> pts;
+    for (std::size_t i = 0; i < r.ape_trans_m.size(); ++i) {
+      pts.emplace_back(time_of(r.gt, i, options), r.ape_trans_m[i]);
+    }
+    Chart c;
+    c.set_title(fmt::format("APE, translation part ({}), {} pairs", alignment_text(r), r.pairs.size()));
+    c.set_xlabel(time_axis(options));
+    c.set_ylabel("APE [m]");
+    c.set_y_from_zero(true);
+    c.add_line(std::move(pts), {kBlue, 1, false}, "APE");
+    add_statistic_lines(c, r.ape_trans_stats, "m");
+    cv::Mat img(450, 1100, CV_8UC3);
+    c.draw(img);
+    written.push_back(dir / "ape.png");
+    save(img, written.back());
+  }
+
+  {  // RPE over time: translation above, rotation below, at the end pose of each pair.
+    std::vector<cv::Point2d> trans, rot;
+    for (std::size_t k = 0; k < r.rpe.pairs.size(); ++k) {
+      const double t = time_of(r.gt, r.rpe.pairs[k].second, options);
+      trans.emplace_back(t, r.rpe.trans_m[k]);
+      rot.emplace_back(t, r.rpe.rot_deg[k]);
+    }
+    const auto& o = r.rpe_options;
+    const std::string delta = fmt::format("delta {} {}, {} pairs", o.delta,
+                                          o.unit == DeltaUnit::kMeters ? "m" : o.delta == 1.0 ? "frame" : "frames",
+                                          o.all_pairs ? "all" : "consecutive");
+    cv::Mat img(800, 1100, CV_8UC3);
+    Chart ct;
+    ct.set_title("RPE, translation (" + delta + ")");
+    ct.set_xlabel(time_axis(options));
+    ct.set_ylabel("RPE trans. [m]");
+    ct.set_y_from_zero(true);
+    ct.add_line(std::move(trans), {kBlue, 1, false}, "RPE trans.");
+    add_statistic_lines(ct, r.rpe_trans_stats, "m");
+    cv::Mat upper = img(cv::Rect(0, 0, img.cols, img.rows / 2));
+    ct.draw(upper);
+    Chart cr;
+    cr.set_title("RPE, rotation angle (" + delta + ")");
+    cr.set_xlabel(time_axis(options));
+    cr.set_ylabel("RPE rot. [deg]");
+    cr.set_y_from_zero(true);
+    cr.add_line(std::move(rot), {kOrange, 1, false}, "RPE rot.");
+    add_statistic_lines(cr, r.rpe_rot_stats, "deg");
+    cv::Mat lower = img(cv::Rect(0, img.rows / 2, img.cols, img.rows - img.rows / 2));
+    cr.draw(lower);
+    written.push_back(dir / "rpe.png");
+    save(img, written.back());
+  }
+  return written;
+}
+
+}  // namespace plslam::eval

@@ -1,0 +1,88 @@
+#pragma once
+// Stereo point + line bundle adjustment on Ceres with the analytic costs of ceres_costs.h and a
+// Schur-complement solver (landmarks eliminated first). The problem is plain data: keyframe
+// poses T_cw with fixed flags, landmarks, and observations indexing them. A local BA is this
+// problem restricted to a window, with the covisible keyframes outside it marked fixed.
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "plslam/geometry/se3.h"
+#include "plslam/geometry/stereo_camera.h"
+#include "plslam/geometry/triangulation.h"
+#include "plslam/optim/observations.h"
+#include "plslam/optim/robust.h"
+
+namespace plslam::optim {
+
+struct BaKeyframe {
+  geometry::SE3 T_cw;
+  bool fixed = false;
+};
+
+struct BaPoint {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  bool fixed = false;
+};
+
+// A 3D line parameterised by its two world endpoints (each 3 DoF). The position of an endpoint
+// along the line is not observable; the LM damping keeps it where it is.
+struct BaLine {
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();
+  Eigen::Vector3d end = Eigen::Vector3d::Zero();
+  bool fixed = false;
+};
+
+struct BaProblem {
+  std::vector<BaKeyframe> keyframes;
+  std::vector<BaPoint> points;
+  std::vector<BaLine> lines;
+  std::vector<StereoPointObservation> point_observations;
+  std::vector<StereoLineObservation> line_observations;
+};
+
+enum class BaLinearSolver { kDenseSchur, kSparseSchur };
+
+struct BaOptions {
+  int iterations = 10;  // LM iterations of the first pass
+  // After the first (robust) pass, drop the observations beyond their chi-square gate and run
+  // `second_pass_iterations` more without the robust kernel (ORB-SLAM2's local BA).
+  bool remove_outliers = false;
+  int second_pass_iterations = 10;
+  bool robust = true;
+  double chi2_point_stereo = kChi2Stereo3Dof;
+  double chi2_point_mono = kChi2Mono2Dof;
+  double chi2_line_pair = kChi2LinePair2Dof;
+  double scale_factor = 1.2;
+  BaLinearSolver linear_solver = BaLinearSolver::kDenseSchur;
+  int num_threads = 1;
+};
+
+struct BaResult {
+  std::vector<geometry::SE3> poses;            // one per keyframe (fixed ones unchanged)
+  std::vector<Eigen::Vector3d> points;         // one per point
+  std::vector<geometry::Segment3d> lines;      // one per line
+  std::vector<bool> point_observation_outlier;  // per observation, gated at the final state
+  std::vector<bool> line_observation_outlier;
+  double initial_cost = 0.0;  // Ceres cost (1/2 sum rho) at the start of the first pass
+  double final_cost = 0.0;    // ... at the end of the last pass
+  int iterations = 0;
+  bool usable = false;  // Ceres produced a usable solution
+  std::string message;  // Ceres' brief report of the last pass (for logs)
+};
+
+// Throws InputError when an observation indexes outside the problem's arrays.
+BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& problem,
+                       const BaOptions& options = {});
+
+// Local BA: bundle_adjust with remove_outliers on. When no keyframe is marked fixed the first one
+// is fixed to remove the gauge freedom.
+BaResult local_bundle_adjustment(const geometry::StereoCamera& cam, const BaProblem& problem,
+                                 BaOptions options = {});
+
+// Global BA: all keyframes free except the first.
+BaResult global_bundle_adjustment(const geometry::StereoCamera& cam, const BaProblem& problem,
+                                  const BaOptions& options = {});
+
+}  // namespace plslam::optim
