@@ -1,4 +1,6 @@
-// Local and global BA on a synthetic 10-keyframe stereo window with exact observations.
+// Local and global BA on a synthetic 10-keyframe stereo window with exact observations, for both
+// backends (hand-written Schur LM and Ceres), and agreement between the two.
+#include <algorithm>
 #include <cstdio>
 #include <random>
 #include <set>
@@ -38,14 +40,29 @@ Errors errors(const test::BaScene& s, const BaResult& r) {
   return e;
 }
 
-TEST(BundleAdjustment, LocalWindowConvergesToGroundTruth) {
+const char* backend_name(BaBackend b) { return b == BaBackend::kSchurLM ? "SchurLM" : "Ceres"; }
+
+class BundleAdjustmentBackends : public ::testing::TestWithParam<BaBackend> {
+ protected:
+  BaOptions options() const {
+    BaOptions opt;
+    opt.backend = GetParam();
+    return opt;
+  }
+};
+
+INSTANTIATE_TEST_SUITE_P(Backends, BundleAdjustmentBackends,
+                         ::testing::Values(BaBackend::kSchurLM, BaBackend::kCeres),
+                         [](const auto& info) { return std::string(backend_name(info.param)); });
+
+TEST_P(BundleAdjustmentBackends, LocalWindowConvergesToGroundTruth) {
   const auto cam = test::kitti_like_camera();
   std::mt19937 rng(1);
   auto scene = test::make_ba_scene(cam, 10, 600, 80, rng);
   // Keyframes 0 and 1 play the covisible keyframes outside the window: fixed at ground truth.
   scene.problem.keyframes[0].fixed = scene.problem.keyframes[1].fixed = true;
   test::perturb(&scene.problem, 0.05, 0.01, 0.05, rng);
-  BaOptions opt;
+  BaOptions opt = options();
   opt.iterations = 15;
   const BaResult r = local_bundle_adjustment(cam, scene.problem, opt);
   ASSERT_TRUE(r.usable) << r.message;
@@ -60,7 +77,7 @@ TEST(BundleAdjustment, LocalWindowConvergesToGroundTruth) {
   EXPECT_EQ(std::count(r.line_observation_outlier.begin(), r.line_observation_outlier.end(), true), 0);
 }
 
-TEST(BundleAdjustment, LocalWindowRemovesGrossOutliers) {
+TEST_P(BundleAdjustmentBackends, LocalWindowRemovesGrossOutliers) {
   const auto cam = test::kitti_like_camera();
   std::mt19937 rng(2);
   auto scene = test::make_ba_scene(cam, 10, 600, 80, rng);
@@ -78,7 +95,7 @@ TEST(BundleAdjustment, LocalWindowRemovesGrossOutliers) {
     bad_line[i] = true;
   }
   test::perturb(&scene.problem, 0.03, 0.005, 0.03, rng);
-  BaOptions opt;
+  BaOptions opt = options();
   opt.iterations = 15;
   const BaResult r = local_bundle_adjustment(cam, scene.problem, opt);
   ASSERT_TRUE(r.usable) << r.message;
@@ -117,13 +134,13 @@ TEST(BundleAdjustment, LocalWindowRemovesGrossOutliers) {
   EXPECT_LE(flagged_good, 10);
 }
 
-TEST(BundleAdjustment, GlobalConvergesWithFirstKeyframeFixed) {
+TEST_P(BundleAdjustmentBackends, GlobalConvergesWithFirstKeyframeFixed) {
   const auto cam = test::kitti_like_camera();
   std::mt19937 rng(3);
   auto scene = test::make_ba_scene(cam, 10, 600, 80, rng);
   test::perturb(&scene.problem, 0.05, 0.01, 0.05, rng);
   scene.problem.keyframes[0].T_cw = scene.poses_true[0];  // the gauge: the first keyframe
-  BaOptions opt;
+  BaOptions opt = options();
   opt.iterations = 20;
   opt.linear_solver = BaLinearSolver::kSparseSchur;
   const BaResult r = global_bundle_adjustment(cam, scene.problem, opt);
@@ -135,12 +152,182 @@ TEST(BundleAdjustment, GlobalConvergesWithFirstKeyframeFixed) {
   EXPECT_LT((r.poses[0].matrix() - scene.poses_true[0].matrix()).norm(), 1e-15);
 }
 
-TEST(BundleAdjustment, BadIndexIsAnInputError) {
+TEST_P(BundleAdjustmentBackends, BadIndexIsAnInputError) {
   const auto cam = test::kitti_like_camera();
   BaProblem p;
   p.keyframes.push_back({});
   p.point_observations.push_back({});  // point 0 does not exist
-  EXPECT_THROW(bundle_adjust(cam, p), InputError);
+  EXPECT_THROW(bundle_adjust(cam, p, options()), InputError);
+}
+
+TEST_P(BundleAdjustmentBackends, EmptyProblemIsNotUsable) {
+  const auto cam = test::kitti_like_camera();
+  BaProblem p;
+  p.keyframes.push_back({});
+  const BaResult r = bundle_adjust(cam, p, options());
+  EXPECT_FALSE(r.usable);
+  ASSERT_EQ(r.poses.size(), 1u);
+  EXPECT_LT((r.poses[0].matrix() - Eigen::Matrix4d::Identity()).norm(), 1e-15);
+}
+
+// Fixed landmarks stay exactly where they are and still constrain the free keyframes.
+TEST_P(BundleAdjustmentBackends, FixedLandmarksStayAndConstrain) {
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(4);
+  auto scene = test::make_ba_scene(cam, 6, 300, 40, rng);
+  scene.problem.keyframes[0].fixed = true;
+  for (std::size_t i = 0; i < scene.problem.points.size(); i += 3) scene.problem.points[i].fixed = true;
+  for (std::size_t i = 0; i < scene.problem.lines.size(); i += 3) scene.problem.lines[i].fixed = true;
+  test::perturb(&scene.problem, 0.03, 0.005, 0.0, rng);  // landmarks exact, poses off
+  // Perturb only the free landmarks.
+  std::normal_distribution<double> g(0.0, 0.03);
+  for (auto& pt : scene.problem.points) {
+    if (!pt.fixed) pt.position += Eigen::Vector3d(g(rng), g(rng), g(rng));
+  }
+  for (auto& l : scene.problem.lines) {
+    if (!l.fixed) l.start += Eigen::Vector3d(g(rng), g(rng), g(rng));
+  }
+  BaOptions opt = options();
+  opt.iterations = 20;
+  const BaResult r = bundle_adjust(cam, scene.problem, opt);
+  ASSERT_TRUE(r.usable) << r.message;
+  const Errors e = errors(scene, r);
+  EXPECT_LT(e.pose_trans, 1e-3);
+  EXPECT_LT(e.line, 0.01);
+  for (std::size_t i = 0; i < scene.problem.points.size(); i += 3) {
+    EXPECT_EQ(r.points[i], scene.problem.points[i].position);
+  }
+  for (std::size_t i = 0; i < scene.problem.lines.size(); i += 3) {
+    EXPECT_EQ(r.lines[i].start, scene.problem.lines[i].start);
+    EXPECT_EQ(r.lines[i].end, scene.problem.lines[i].end);
+  }
+}
+
+// Endpoints displaced ALONG their 3D line cost nothing (the 2-D gauge of each line block): with
+// the endpoints slid along the true lines and the poses and points perturbed, the damped system
+// must neither blow up nor let the endpoints wander along their line.
+TEST_P(BundleAdjustmentBackends, LineEndpointsSlidingAlongTheLineStayWellConditioned) {
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(5);
+  auto scene = test::make_ba_scene(cam, 8, 300, 60, rng);
+  scene.problem.keyframes[0].fixed = true;
+  std::uniform_real_distribution<double> slide(-0.3, 0.3);
+  std::normal_distribution<double> g(0.0, 0.02);
+  std::vector<Eigen::Vector3d> start_along, end_along;  // initial endpoints, on the true line
+  for (auto& l : scene.problem.lines) {
+    const Eigen::Vector3d d = (l.end - l.start).normalized();
+    l.start += slide(rng) * d;
+    l.end += slide(rng) * d;
+    start_along.push_back(l.start);
+    end_along.push_back(l.end);
+  }
+  test::perturb(&scene.problem, 0.02, 0.005, 0.0, rng);
+  for (auto& pt : scene.problem.points) pt.position += Eigen::Vector3d(g(rng), g(rng), g(rng));
+  BaOptions opt = options();
+  opt.iterations = 50;  // long enough for the damping to reach its floor
+  const BaResult r = bundle_adjust(cam, scene.problem, opt);
+  ASSERT_TRUE(r.usable) << r.message;
+  const Errors e = errors(scene, r);
+  EXPECT_LT(e.pose_trans, 1e-3);
+  EXPECT_LT(e.line, 1e-3);
+  double drift = 0.0;  // along-line motion of the endpoints, relative to their start on the line
+  for (std::size_t i = 0; i < r.lines.size(); ++i) {
+    ASSERT_TRUE(r.lines[i].start.allFinite() && r.lines[i].end.allFinite());
+    const Eigen::Vector3d d = (scene.lines_true[i].end - scene.lines_true[i].start).normalized();
+    drift = std::max({drift, std::abs(d.dot(r.lines[i].start - start_along[i])),
+                      std::abs(d.dot(r.lines[i].end - end_along[i]))});
+  }
+  std::printf("max endpoint drift along the line %.3g m\n", drift);
+  EXPECT_LT(drift, 0.05);  // vs. slides of up to 0.3 m
+}
+
+// The two backends minimise the same cost: identical initial cost, and after convergence on
+// noisy observations (a unique optimum up to the line gauge) the same poses and final cost.
+TEST(BundleAdjustment, BackendsAgreeOnNoisyProblem) {
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(6);
+  auto scene = test::make_ba_scene(cam, 8, 400, 60, rng);
+  scene.problem.keyframes[0].fixed = scene.problem.keyframes[1].fixed = true;
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (auto& o : scene.problem.point_observations) {
+    o.measurement += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    o.level = static_cast<int>(rng() % 4);
+  }
+  for (auto& o : scene.problem.line_observations) {
+    o.left_line(2) += 3.0 * noise(rng);  // some pairs beyond the Huber threshold
+    o.right_line(2) += noise(rng);
+  }
+  scene.problem.point_observations[7].has_right = false;
+  test::perturb(&scene.problem, 0.02, 0.005, 0.02, rng);
+  BaOptions opt;
+  opt.iterations = 50;
+  opt.backend = BaBackend::kSchurLM;
+  const BaResult a = bundle_adjust(cam, scene.problem, opt);
+  opt.backend = BaBackend::kCeres;
+  const BaResult b = bundle_adjust(cam, scene.problem, opt);
+  ASSERT_TRUE(a.usable && b.usable) << a.message << " / " << b.message;
+  std::printf("cost %.9g -> %.9g (Schur LM), %.9g -> %.9g (Ceres)\n", a.initial_cost,
+              a.final_cost, b.initial_cost, b.final_cost);
+  EXPECT_NEAR(a.initial_cost, b.initial_cost, 1e-9 * b.initial_cost);
+  EXPECT_NEAR(a.final_cost, b.final_cost, 1e-6 * b.final_cost);
+  double pose_diff = 0.0, point_diff = 0.0;
+  for (std::size_t k = 0; k < a.poses.size(); ++k) {
+    pose_diff = std::max(pose_diff, test::centre_error(a.poses[k], b.poses[k]));
+  }
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    point_diff = std::max(point_diff, (a.points[i] - b.points[i]).norm());
+  }
+  EXPECT_LT(pose_diff, 1e-6);
+  EXPECT_LT(point_diff, 1e-4);
+  EXPECT_EQ(a.point_observation_outlier, b.point_observation_outlier);
+  EXPECT_EQ(a.line_observation_outlier, b.line_observation_outlier);
+}
+
+// Threads only split the sums: the result matches the single-thread one to rounding.
+TEST(BundleAdjustment, SchurLmThreadsGiveTheSameResult) {
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(7);
+  auto scene = test::make_ba_scene(cam, 10, 600, 80, rng);
+  scene.problem.keyframes[0].fixed = true;
+  test::perturb(&scene.problem, 0.03, 0.005, 0.03, rng);
+  BaOptions opt;
+  opt.iterations = 5;
+  const BaResult one = bundle_adjust(cam, scene.problem, opt);
+  opt.num_threads = 2;
+  const BaResult two = bundle_adjust(cam, scene.problem, opt);
+  EXPECT_EQ(one.iterations, two.iterations);
+  EXPECT_NEAR(one.final_cost, two.final_cost, 1e-9 * one.initial_cost);
+  for (std::size_t k = 0; k < one.poses.size(); ++k) {
+    EXPECT_LT(test::centre_error(one.poses[k], two.poses[k]), 1e-9);
+  }
+}
+
+// A landmark behind one of its cameras at the start: Ceres cannot evaluate the problem, the
+// Schur LM backend drops that observation from the pass and flags it.
+TEST(BundleAdjustment, SchurLmDropsObservationsBehindTheCamera) {
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(8);
+  auto scene = test::make_ba_scene(cam, 6, 300, 40, rng);
+  scene.problem.keyframes[0].fixed = true;
+  // A fixed keyframe turned around (180 degrees about its y axis) with a bogus observation of
+  // the first observation's point, which is therefore behind it.
+  BaKeyframe behind{geometry::SE3::exp((geometry::Vector6d() << 0, 0, 0, 0, M_PI, 0).finished()) *
+                        scene.poses_true[0],
+                    true};
+  scene.problem.keyframes.push_back(behind);
+  StereoPointObservation bogus = scene.problem.point_observations[0];
+  bogus.keyframe = static_cast<int>(scene.problem.keyframes.size()) - 1;
+  scene.problem.point_observations.push_back(bogus);
+  scene.poses_true.push_back(behind.T_cw);
+  test::perturb(&scene.problem, 0.02, 0.005, 0.02, rng);
+  BaOptions opt;
+  opt.iterations = 20;
+  const BaResult r = bundle_adjust(cam, scene.problem, opt);
+  ASSERT_TRUE(r.usable) << r.message;
+  EXPECT_NE(r.message.find("1 observations dropped"), std::string::npos) << r.message;
+  EXPECT_TRUE(r.point_observation_outlier.back());
+  EXPECT_EQ(std::count(r.point_observation_outlier.begin(), r.point_observation_outlier.end(), true), 1);
+  EXPECT_LT(errors(scene, r).pose_trans, 1e-3);
 }
 
 }  // namespace

@@ -1,6 +1,9 @@
 #pragma once
-// Stereo point + line bundle adjustment on Ceres with the analytic costs of ceres_costs.h and a
-// Schur-complement solver (landmarks eliminated first). The problem is plain data: keyframe
+// Stereo point + line bundle adjustment with the analytic residuals of stereo_point_residual.h /
+// stereo_line_residual.h and the landmarks eliminated by the Schur complement. Two backends
+// minimise the same cost: a hand-written Levenberg-Marquardt with a dense reduced camera system
+// (ba_schur_lm.cpp, the default: several times faster for local windows) and Ceres
+// (ba_ceres_pass.cpp, DENSE_SCHUR / SPARSE_SCHUR). The problem is plain data: keyframe
 // poses T_cw with fixed flags, landmarks, and observations indexing them. A local BA is this
 // problem restricted to a window, with the covisible keyframes outside it marked fixed.
 #include <string>
@@ -42,10 +45,18 @@ struct BaProblem {
   std::vector<StereoLineObservation> line_observations;
 };
 
-enum class BaLinearSolver { kDenseSchur, kSparseSchur };
+enum class BaLinearSolver { kDenseSchur, kSparseSchur };  // Ceres backend only
+
+enum class BaBackend {
+  kSchurLM,  // hand-written LM, dense reduced camera system (6 unknowns per free keyframe)
+  kCeres,    // Ceres 2.1 with `linear_solver`
+};
 
 struct BaOptions {
   int iterations = 10;  // LM iterations of the first pass
+  // Stop a pass when a step changes the cost by less than this fraction (Ceres' default);
+  // 0 runs every iteration (benchmarks at a fixed iteration count).
+  double function_tolerance = 1e-6;
   // After the first (robust) pass, drop the observations beyond their chi-square gate and run
   // `second_pass_iterations` more without the robust kernel (ORB-SLAM2's local BA).
   bool remove_outliers = false;
@@ -55,8 +66,12 @@ struct BaOptions {
   double chi2_point_mono = kChi2Mono2Dof;
   double chi2_line_pair = kChi2LinePair2Dof;
   double scale_factor = 1.2;
+  BaBackend backend = BaBackend::kSchurLM;
+  // kSchurLM factors a dense (6 n)^2 camera system; with more free keyframes than this the
+  // problem goes to Ceres' SPARSE_SCHUR instead (a large global BA).
+  int max_dense_keyframes = 300;
   BaLinearSolver linear_solver = BaLinearSolver::kDenseSchur;
-  int num_threads = 1;
+  int num_threads = 1;  // both backends (kSchurLM: TBB over landmarks)
 };
 
 struct BaResult {
@@ -65,14 +80,17 @@ struct BaResult {
   std::vector<geometry::Segment3d> lines;      // one per line
   std::vector<bool> point_observation_outlier;  // per observation, gated at the final state
   std::vector<bool> line_observation_outlier;
-  double initial_cost = 0.0;  // Ceres cost (1/2 sum rho) at the start of the first pass
+  double initial_cost = 0.0;  // cost (1/2 sum rho, Ceres' definition) at the start of pass 1
   double final_cost = 0.0;    // ... at the end of the last pass
   int iterations = 0;
-  bool usable = false;  // Ceres produced a usable solution
-  std::string message;  // Ceres' brief report of the last pass (for logs)
+  bool usable = false;  // the solver produced a usable solution (false: no observations)
+  std::string message;  // the solver's brief report of the last pass (for logs)
 };
 
 // Throws InputError when an observation indexes outside the problem's arrays.
+// An observation whose landmark is behind its camera at the start of a pass makes the Ceres
+// backend fail (usable = false); kSchurLM leaves it out of that pass instead. Either way it is
+// flagged as an outlier in the result.
 BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& problem,
                        const BaOptions& options = {});
 

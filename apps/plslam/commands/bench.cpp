@@ -1,0 +1,92 @@
+// plslam bench <stage> <dataset>: per-stage timings of the front end on real frames.
+//   plslam bench features <dataset> [--frames N] [--json]
+#include <iostream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "command_registry.h"
+#include "commands/dataset_options.h"
+#include "plslam/core/error.h"
+#include "plslam/features/point_benchmark.h"
+
+namespace plslam::cli {
+namespace {
+
+struct BenchFeaturesArgs {
+  DatasetArgs dataset;
+  bool json = false;
+  int n_features = 0;
+  int fast_threshold = 7;
+  std::string fast_mode = "single";
+  double right_factor = 2.0;
+};
+
+std::string stage_line(const nlohmann::json& j, const char* key, const char* label) {
+  const auto& s = j.at(key);
+  return fmt::format("  {:<22} median {:7.3f}  p90 {:7.3f}  ms\n", label, s.at("median").get<double>(),
+                     s.at("p90").get<double>());
+}
+
+int run_bench_features(const BenchFeaturesArgs& args) {
+  const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
+  if (ds->size() == 0) throw InputError(args.dataset.path, "no frames selected");
+  features::PointBenchmarkOptions o;
+  o.n_features = args.n_features;
+  o.orb.fast_mode = features::parse_fast_mode(args.fast_mode);
+  o.orb.fast_threshold = args.fast_threshold;
+  o.right_feature_factor = args.right_factor;
+  if (!(o.right_feature_factor >= 1.0)) throw InputError("", "--right-factor must be >= 1");
+  const nlohmann::json j = features::run_point_benchmark(*ds, o);
+  if (args.json) {
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << fmt::format("{} ({}), {} frames, {}x{}, {} features, one thread\n", j["dataset"].get<std::string>(),
+                           j["format"].get<std::string>(), j["frames"].get<int>(), j["width"].get<int>(),
+                           j["height"].get<int>(), j["config"]["n_features"].get<int>())
+            << "points, left image:\n"
+            << stage_line(j, "pyramid_ms", "pyramid") << stage_line(j, "fast_ms", "FAST")
+            << stage_line(j, "ssc_ms", "SSC") << stage_line(j, "quadtree_ms", "quadtree (same input)")
+            << stage_line(j, "orb_ms", "orientation+BRIEF") << stage_line(j, "left_extract_ms", "left total (no quadtree)")
+            << stage_line(j, "right_extract_ms", "right image extraction") << stage_line(j, "stereo_points_ms", "stereo matching")
+            << fmt::format("  SSC speed-up over quadtree  {:.1f}x\n", j["ssc_speedup"].get<double>())
+            << fmt::format("  keypoints  FAST {:.0f}  SSC {:.0f}  quadtree {:.0f}  (medians)\n",
+                           j["keypoints"]["fast_candidates"]["median"].get<double>(), j["keypoints"]["median"].get<double>(),
+                           j["keypoints"]["quadtree"]["median"].get<double>())
+            << fmt::format("  stereo matches {:.0f} ({:.1f} % of left keypoints)\n", j["stereo_matches"]["median"].get<double>(),
+                           100.0 * j["stereo_matches"]["share"]["median"].get<double>())
+            << fmt::format("  uniformity CV (16x12 grid, lower is better)  SSC {:.3f}  quadtree {:.3f}\n",
+                           j["uniformity_cv"]["ssc"]["median"].get<double>(),
+                           j["uniformity_cv"]["quadtree"]["median"].get<double>());
+  return 0;
+}
+
+CommandRegistration reg({"bench", "Benchmark front-end stages on real frames", [](CLI::App& sub) {
+                           sub.require_subcommand(1);
+                           auto args = std::make_shared<BenchFeaturesArgs>();
+                           CLI::App* features = sub.add_subcommand("features", "Point features: per-stage ms, counts, uniformity");
+                           features->add_option("dataset", args->dataset.path, "KITTI sequences/NN or EuRoC <seq>[/mav0]")->required();
+                           features->add_option("--format", args->dataset.format, "Dataset format")
+                               ->check(CLI::IsMember({"auto", "kitti", "euroc"}))
+                               ->capture_default_str();
+                           features->add_option("--start", args->dataset.start, "First frame")->capture_default_str();
+                           features->add_option("--frames,--max-frames", args->dataset.max_frames, "At most this many frames (-1: all)")
+                               ->capture_default_str();
+                           features->add_flag("--json", args->json, "Print a JSON object");
+                           features->add_option("--features", args->n_features, "Keypoints per image (0: 1200 EuRoC, 2000 KITTI)")
+                               ->check(CLI::NonNegativeNumber)->capture_default_str();
+                           features->add_option("--fast-threshold", args->fast_threshold, "FAST threshold (single mode)")
+                               ->check(CLI::Range(1, 254))->capture_default_str();
+                           features->add_option("--fast-mode", args->fast_mode, "single | ini_min (20/7 per cell)")
+                               ->check(CLI::IsMember({"single", "ini_min"}))->capture_default_str();
+                           features->add_option("--right-factor", args->right_factor, "Right image keeps this many times more points")
+                               ->capture_default_str();
+                           return std::function<int()>([args, features] {
+                             if (features->parsed()) return run_bench_features(*args);
+                             return 2;
+                           });
+                         }});
+
+}  // namespace
+}  // namespace plslam::cli

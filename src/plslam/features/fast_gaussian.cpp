@@ -1,0 +1,49 @@
+#include "plslam/features/fast_gaussian.h"
+
+#include <cstdint>
+#include <stdexcept>
+#include <vector>
+
+namespace plslam::features {
+namespace {
+
+// exp(-x^2 / (2 * 2^2)) for x = 0..3, normalised and scaled to sum to 256.
+constexpr int k0 = 56, k1 = 49, k2 = 33, k3 = 18;
+static_assert(k0 + 2 * (k1 + k2 + k3) == 256);
+
+}  // namespace
+
+void gaussian_blur_7x7(const cv::Mat& src, const cv::Rect& rect, cv::Mat& dst) {
+  if (src.type() != CV_8UC1 || rect.x < 3 || rect.y < 3 || rect.x + rect.width + 3 > src.cols ||
+      rect.y + rect.height + 3 > src.rows)
+    throw std::invalid_argument("gaussian_blur_7x7: need 8-bit input with 3 pixels around the rectangle");
+  const int w = rect.width, h = rect.height;
+  dst.create(h, w, CV_8U);
+  // Horizontal pass over the rows the vertical pass needs (3 above and below).
+  thread_local std::vector<uint8_t> tmp;
+  tmp.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h + 6));
+  for (int r = 0; r < h + 6; ++r) {
+    const uint8_t* s = src.ptr<uint8_t>(rect.y - 3 + r) + rect.x;
+    uint8_t* t = tmp.data() + static_cast<std::size_t>(r) * static_cast<std::size_t>(w);
+    for (int x = 0; x < w; ++x) {
+      // 16-bit lanes suffice (at most 256 * 255 + 128), which doubles the vector width.
+      const uint16_t v = static_cast<uint16_t>(k0 * s[x]) + static_cast<uint16_t>(k1 * static_cast<uint16_t>(s[x - 1] + s[x + 1])) +
+                         static_cast<uint16_t>(k2 * static_cast<uint16_t>(s[x - 2] + s[x + 2])) +
+                         static_cast<uint16_t>(k3 * static_cast<uint16_t>(s[x - 3] + s[x + 3])) + uint16_t{128};
+      t[x] = static_cast<uint8_t>(v >> 8);
+    }
+  }
+  const std::size_t ws = static_cast<std::size_t>(w);
+  for (int r = 0; r < h; ++r) {
+    const uint8_t* c = tmp.data() + static_cast<std::size_t>(r + 3) * ws;
+    uint8_t* d = dst.ptr<uint8_t>(r);
+    for (int x = 0; x < w; ++x) {
+      const uint16_t v = static_cast<uint16_t>(k0 * c[x]) + static_cast<uint16_t>(k1 * static_cast<uint16_t>(c[x - ws] + c[x + ws])) +
+                         static_cast<uint16_t>(k2 * static_cast<uint16_t>(c[x - 2 * ws] + c[x + 2 * ws])) +
+                         static_cast<uint16_t>(k3 * static_cast<uint16_t>(c[x - 3 * ws] + c[x + 3 * ws])) + uint16_t{128};
+      d[x] = static_cast<uint8_t>(v >> 8);
+    }
+  }
+}
+
+}  // namespace plslam::features

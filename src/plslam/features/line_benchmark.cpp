@@ -1,0 +1,123 @@
+#include "plslam/features/line_benchmark.h"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/line_descriptor.hpp>
+
+namespace plslam::features {
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * (v.size() - 1);
+  const auto lo = static_cast<std::size_t>(pos);
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - lo) * (v[hi] - v[lo]);
+}
+
+nlohmann::json stats(const std::vector<double>& v) {
+  return {{"median", percentile(v, 0.5)}, {"p90", percentile(v, 0.9)}};
+}
+
+// OpenCV's binary LBD on our segments, for the cost comparison.
+double opencv_lbd_ms(const cv::Mat& grey, const std::vector<LineSegment>& lines) {
+  std::vector<cv::line_descriptor::KeyLine> kls;
+  kls.reserve(lines.size());
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const LineSegment& s = lines[i];
+    cv::line_descriptor::KeyLine k;
+    k.startPointX = k.sPointInOctaveX = s.start.x;
+    k.startPointY = k.sPointInOctaveY = s.start.y;
+    k.endPointX = k.ePointInOctaveX = s.end.x;
+    k.endPointY = k.ePointInOctaveY = s.end.y;
+    k.lineLength = s.length();
+    k.numOfPixels = static_cast<int>(s.length());
+    k.angle = s.angle();
+    k.octave = 0;
+    k.class_id = static_cast<int>(i);
+    k.pt = 0.5f * (s.start + s.end);
+    k.response = s.length() / std::max(grey.cols, grey.rows);
+    kls.push_back(k);
+  }
+  auto bd = cv::line_descriptor::BinaryDescriptor::createBinaryDescriptor();
+  cv::Mat desc;
+  const auto t0 = std::chrono::steady_clock::now();
+  bd->compute(grey, kls, desc);
+  return ms_since(t0);
+}
+
+}  // namespace
+
+nlohmann::json benchmark_lines(const std::vector<std::pair<cv::Mat, cv::Mat>>& frames, const StereoCalibration& calib,
+                               const LineBenchmarkOptions& o) {
+  if (frames.empty()) throw std::invalid_argument("benchmark_lines: no frames");
+  std::vector<double> lsd, fast, merge, lbd, image, cv_lbd, stereo, detected, merged, kept, matches;
+  LineExtractorOptions fast_opts = o.extractor;
+  fast_opts.detector.kind = LineDetectorKind::kGrow;
+  for (const auto& [left, right] : frames) {
+    if (o.reference) {
+      // OpenCV's own LSD alone (default parameters, no refinement), full resolution.
+      auto detector = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE);
+      std::vector<cv::Vec4f> raw;
+      const auto t0 = std::chrono::steady_clock::now();
+      detector->detect(left, raw);
+      lsd.push_back(ms_since(t0));
+    }
+    LineTimings tl, tr;
+    const LineFeatures fl = extract_lines(left, fast_opts, &tl);
+    const LineFeatures fr = extract_lines(right, fast_opts, &tr);
+    for (const LineTimings* t : {&tl, &tr}) {
+      fast.push_back(t->detect_ms);
+      merge.push_back(t->merge_ms);
+      lbd.push_back(t->describe_ms);
+      image.push_back(t->total_ms());
+      detected.push_back(static_cast<double>(t->detected));
+      merged.push_back(static_cast<double>(t->merged));
+      kept.push_back(static_cast<double>(t->kept));
+    }
+    if (o.reference) cv_lbd.push_back(opencv_lbd_ms(left, fl.lines));
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto m = matching::match_stereo_lines(fl, fr, calib, o.stereo);
+    stereo.push_back(ms_since(t0));
+    matches.push_back(static_cast<double>(m.size()));
+  }
+  nlohmann::json j;
+  j["frames"] = frames.size();
+  j["fast_lines_ms"] = stats(fast);
+  j["merge_ms"] = stats(merge);
+  j["lbd_ms"] = stats(lbd);
+  j["lines_image_ms"] = stats(image);
+  j["stereo_lines_ms"] = stats(stereo);
+  j["lines_detected"] = stats(detected);
+  j["lines_after_merge"] = stats(merged);
+  j["lines_kept"] = stats(kept);
+  j["stereo_line_matches"] = stats(matches);
+  if (o.reference) {
+    j["lsd_ms"] = stats(lsd);
+    j["opencv_lbd_ms"] = stats(cv_lbd);
+    j["lines_speedup_vs_opencv"] = (percentile(lsd, 0.5) + percentile(cv_lbd, 0.5)) / percentile(image, 0.5);
+  }
+  return j;
+}
+
+nlohmann::json benchmark_lines(const io::Dataset& dataset, std::size_t n, const LineBenchmarkOptions& o) {
+  const std::size_t count = n == 0 ? dataset.size() : std::min(n, dataset.size());
+  std::vector<std::pair<cv::Mat, cv::Mat>> frames;
+  frames.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    io::StereoFrame f = dataset.load(i);
+    frames.emplace_back(std::move(f.left), std::move(f.right));
+  }
+  return benchmark_lines(frames, dataset.calibration(), o);
+}
+
+}  // namespace plslam::features

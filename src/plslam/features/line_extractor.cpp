@@ -1,0 +1,36 @@
+#include "plslam/features/line_extractor.h"
+
+#include <chrono>
+
+namespace plslam::features {
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+LineFeatures extract_lines(const cv::Mat& grey, const LineExtractorOptions& o, LineTimings* timings) {
+  LineTimings t;
+  auto t0 = std::chrono::steady_clock::now();
+  DetectedLines det = detect_lines(grey, o.detector);
+  t.detect_ms = ms_since(t0);
+  t.detected = det.segments.size();
+
+  t0 = std::chrono::steady_clock::now();
+  LineFeatures f;
+  f.image_size = grey.size();
+  f.lines = o.merge_enabled ? merge_segments(std::move(det.segments), grey.size(), o.merge) : std::move(det.segments);
+  t.merged = f.lines.size();
+  keep_best(f.lines, o.max_lines);
+  t.kept = f.lines.size();
+  t.merge_ms = ms_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  f.descriptors = describe_lines(det.gradient, f.lines, o.lbd);
+  t.describe_ms = ms_since(t0);
+  if (timings) *timings = t;
+  return f;
+}
+
+}  // namespace plslam::features

@@ -1,0 +1,174 @@
+#include "plslam/features/point_benchmark.h"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <numeric>
+
+#include <opencv2/core/utility.hpp>
+
+#include "plslam/core/log.h"
+#include "plslam/features/keypoint_uniformity.h"
+#include "plslam/matching/stereo_point_frame.h"
+
+namespace plslam::features {
+namespace {
+
+// Thread CPU time: the machine may be shared, and the stages are single-threaded, so CPU time is
+// the per-core cost without other processes' time slices mixed in.
+struct Clock {
+  using time_point = double;
+  static double now() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+  }
+};
+double ms_since(double t0) { return Clock::now() - t0; }
+
+// Level-0 positions of distributed candidates, for the uniformity score.
+std::vector<cv::KeyPoint> to_level0(const PyramidCandidates& kept, const ImagePyramid& pyramid) {
+  std::vector<cv::KeyPoint> out;
+  for (std::size_t l = 0; l < kept.size(); ++l) {
+    const int level = static_cast<int>(l);
+    for (const auto& k : kept[l].keypoints) {
+      cv::KeyPoint p = k;
+      p.pt = {pyramid.from_level_x(k.pt.x + static_cast<float>(kept[l].offset.x), level),
+              pyramid.from_level_y(k.pt.y + static_cast<float>(kept[l].offset.y), level)};
+      out.push_back(p);
+    }
+  }
+  return out;
+}
+
+int count(const PyramidCandidates& c) {
+  int n = 0;
+  for (const auto& lc : c) n += static_cast<int>(lc.keypoints.size());
+  return n;
+}
+
+// Keeps OpenCV's own thread pool out of the measurement and restores it afterwards.
+class SingleThreadedOpenCv {
+ public:
+  SingleThreadedOpenCv() : previous_(cv::getNumThreads()) { cv::setNumThreads(1); }
+  ~SingleThreadedOpenCv() { cv::setNumThreads(previous_); }
+  SingleThreadedOpenCv(const SingleThreadedOpenCv&) = delete;
+  SingleThreadedOpenCv& operator=(const SingleThreadedOpenCv&) = delete;
+
+ private:
+  int previous_;
+};
+
+}  // namespace
+
+nlohmann::json summarize(std::vector<double> values) {
+  if (values.empty()) return {{"median", nullptr}, {"p90", nullptr}, {"mean", nullptr}};
+  std::sort(values.begin(), values.end());
+  auto rank = [&](double q) {
+    const auto i = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1;
+    return values[std::min(i, values.size() - 1)];
+  };
+  const double mean = std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
+  return {{"median", rank(0.5)}, {"p90", rank(0.9)}, {"mean", mean}};
+}
+
+nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchmarkOptions& options) {
+  OrbOptions orb = options.orb;
+  orb.n_features = options.n_features > 0 ? options.n_features
+                                          : (dataset.format() == io::DatasetFormat::kKitti ? 2000 : 1200);
+  const OrbExtractor left_extractor(orb);
+  const OrbExtractor right_extractor(matching::right_image_options(orb, options.right_feature_factor));
+  matching::StereoPointOptions stereo;
+  stereo.bf = dataset.calibration().bf();
+  stereo.baseline = dataset.calibration().baseline;
+
+  const std::size_t frames = options.max_frames > 0 ? std::min(options.max_frames, dataset.size()) : dataset.size();
+  const SingleThreadedOpenCv single_thread;
+  std::vector<double> pyramid_ms, fast_ms, ssc_ms, quadtree_ms, orb_ms, left_ms, right_ms, stereo_ms;
+  std::vector<double> candidates, kept_ssc, kept_quadtree, matches, match_share, cv_ssc, cv_quadtree;
+  cv::Size size;
+  for (std::size_t i = 0; i < frames; ++i) {
+    const io::StereoFrame frame = dataset.load(i);
+    size = frame.left.size();
+    // The first frame runs twice: the first pass only warms caches and allocations.
+    for (int pass = (i == 0 ? 0 : 1); pass < 2; ++pass) {
+      PointFeatures left;
+      auto t0 = Clock::now();
+      left_extractor.build_pyramid(frame.left, left.pyramid);
+      const double t_pyr = ms_since(t0);
+      t0 = Clock::now();
+      const PyramidCandidates cand = left_extractor.detect(left.pyramid);
+      const double t_fast = ms_since(t0);
+      t0 = Clock::now();
+      const PyramidCandidates ssc = left_extractor.distribute(cand, Distribution::kSsc);
+      const double t_ssc = ms_since(t0);
+      t0 = Clock::now();
+      const PyramidCandidates quad = left_extractor.distribute(cand, Distribution::kQuadtree);
+      const double t_quad = ms_since(t0);
+      t0 = Clock::now();
+      left_extractor.describe(left.pyramid, ssc, left);
+      const double t_orb = ms_since(t0);
+      t0 = Clock::now();
+      const PointFeatures right = right_extractor.extract(frame.right);
+      const double t_right = ms_since(t0);
+      t0 = Clock::now();
+      const matching::StereoPointMatches m = matching::match_stereo_points(left, right, stereo);
+      const double t_stereo = ms_since(t0);
+      if (pass == 0) continue;
+      pyramid_ms.push_back(t_pyr);
+      fast_ms.push_back(t_fast);
+      ssc_ms.push_back(t_ssc);
+      quadtree_ms.push_back(t_quad);
+      orb_ms.push_back(t_orb);
+      left_ms.push_back(t_pyr + t_fast + t_ssc + t_orb);
+      right_ms.push_back(t_right);
+      stereo_ms.push_back(t_stereo);
+      candidates.push_back(count(cand));
+      kept_ssc.push_back(count(ssc));
+      kept_quadtree.push_back(count(quad));
+      matches.push_back(m.matched);
+      match_share.push_back(left.keypoints.empty() ? 0.0 : static_cast<double>(m.matched) / static_cast<double>(left.keypoints.size()));
+      cv_ssc.push_back(grid_count_cv(to_level0(ssc, left.pyramid), size));
+      cv_quadtree.push_back(grid_count_cv(to_level0(quad, left.pyramid), size));
+    }
+  }
+
+  nlohmann::json j;
+  j["dataset"] = dataset.root().string();
+  j["format"] = io::to_string(dataset.format());
+  j["frames"] = pyramid_ms.size();
+  j["width"] = size.width;
+  j["height"] = size.height;
+  j["threads"] = 1;
+  j["clock"] = "thread_cpu";
+  j["config"] = {{"n_features", orb.n_features},
+                 {"levels", orb.levels},
+                 {"scale_factor", orb.scale_factor},
+                 {"fast_mode", to_string(orb.fast_mode)},
+                 {"fast_threshold", orb.fast_threshold},
+                 {"fast_ini_threshold", orb.fast_ini_threshold},
+                 {"fast_min_threshold", orb.fast_min_threshold},
+                 {"ssc_tolerance", orb.ssc_tolerance},
+                 {"right_feature_factor", options.right_feature_factor}};
+  j["pyramid_ms"] = summarize(pyramid_ms);
+  j["fast_ms"] = summarize(fast_ms);
+  j["ssc_ms"] = summarize(ssc_ms);
+  j["quadtree_ms"] = summarize(quadtree_ms);
+  j["orb_ms"] = summarize(orb_ms);
+  j["left_extract_ms"] = summarize(left_ms);
+  j["right_extract_ms"] = summarize(right_ms);
+  j["stereo_points_ms"] = summarize(stereo_ms);
+  const double ssc_median = j["ssc_ms"]["median"].is_number() ? j["ssc_ms"]["median"].get<double>() : 0.0;
+  j["ssc_speedup"] = ssc_median > 0 ? j["quadtree_ms"]["median"].get<double>() / ssc_median : 0.0;
+  j["keypoints"] = summarize(kept_ssc);
+  j["keypoints"]["fast_candidates"] = summarize(candidates);
+  j["keypoints"]["quadtree"] = summarize(kept_quadtree);
+  j["stereo_matches"] = summarize(matches);
+  j["stereo_matches"]["share"] = summarize(match_share);
+  j["uniformity_cv"] = summarize(cv_ssc);
+  j["uniformity_cv"]["ssc"] = summarize(cv_ssc);
+  j["uniformity_cv"]["quadtree"] = summarize(cv_quadtree);
+  return j;
+}
+
+}  // namespace plslam::features

@@ -1,0 +1,29 @@
+#pragma once
+// Per-stage timing of the point front end on real stereo frames, for `plslam bench features`:
+// pyramid, FAST, SSC and quadtree on the same candidates, descriptors, stereo matching, plus
+// keypoint counts and spatial uniformity. One thread, so the numbers are per-core costs.
+#include <cstddef>
+
+#include <nlohmann/json.hpp>
+
+#include "plslam/features/orb_extractor.h"
+#include "plslam/io/dataset.h"
+
+namespace plslam::features {
+
+struct PointBenchmarkOptions {
+  std::size_t max_frames = 0;     // 0: every frame of the dataset
+  int n_features = 0;             // 0: 1200 for EuRoC, 2000 for KITTI
+  OrbOptions orb;                 // n_features is overridden as above
+  double right_feature_factor = 2.0;
+};
+
+// JSON keys: pyramid_ms, fast_ms, ssc_ms, quadtree_ms, orb_ms, left_extract_ms,
+// stereo_points_ms (objects with median, p90, mean), keypoints, stereo_matches, uniformity_cv
+// (objects with median), ssc_speedup, and the configuration used.
+nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchmarkOptions& options);
+
+// Median / p90 / mean of a sample, as a JSON object (nearest-rank percentiles).
+nlohmann::json summarize(std::vector<double> values);
+
+}  // namespace plslam::features

@@ -1,0 +1,152 @@
+#include "plslam/features/quadtree.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace plslam::features {
+namespace {
+
+// A node owns the range [begin, end) of a shared index array, so splitting only permutes
+// indices instead of copying keypoint lists as ORB-SLAM2 does.
+struct Node {
+  float x0, y0, x1, y1;
+  int begin, end;
+  int size() const { return end - begin; }
+};
+
+class QuadTree {
+ public:
+  QuadTree(const std::vector<cv::KeyPoint>& kps) : kps_(kps) {}
+
+  // Splits `n` into up to four non-empty children appended to `out`. Returns how many of them
+  // hold more than one point (the ones that may split again).
+  int split(const Node& n, std::vector<Node>& out) {
+    const float xm = 0.5f * (n.x0 + n.x1), ym = 0.5f * (n.y0 + n.y1);
+    std::array<int, 4> count{};
+    scratch_.resize(static_cast<std::size_t>(n.size()));
+    for (int i = n.begin; i < n.end; ++i) {
+      const auto& p = kps_[static_cast<std::size_t>(idx_[static_cast<std::size_t>(i)])].pt;
+      ++count[static_cast<std::size_t>(quadrant(p, xm, ym))];
+    }
+    std::array<int, 4> pos{0, count[0], count[0] + count[1], count[0] + count[1] + count[2]};
+    const std::array<int, 4> first = pos;
+    for (int i = n.begin; i < n.end; ++i) {
+      const int id = idx_[static_cast<std::size_t>(i)];
+      const int q = quadrant(kps_[static_cast<std::size_t>(id)].pt, xm, ym);
+      scratch_[static_cast<std::size_t>(pos[static_cast<std::size_t>(q)]++)] = id;
+    }
+    std::copy(scratch_.begin(), scratch_.end(), idx_.begin() + n.begin);
+    const std::array<std::array<float, 4>, 4> boxes{{{n.x0, n.y0, xm, ym}, {xm, n.y0, n.x1, ym},
+                                                      {n.x0, ym, xm, n.y1}, {xm, ym, n.x1, n.y1}}};
+    int splittable = 0;
+    for (std::size_t q = 0; q < 4; ++q) {
+      if (count[q] == 0) continue;
+      const auto& b = boxes[q];
+      out.push_back({b[0], b[1], b[2], b[3], n.begin + first[q], n.begin + first[q] + count[q]});
+      if (count[q] > 1) ++splittable;
+    }
+    return splittable;
+  }
+
+  std::vector<int> idx_;
+
+ private:
+  static int quadrant(const cv::Point2f& p, float xm, float ym) {
+    return (p.x < xm ? 0 : 1) + (p.y < ym ? 0 : 2);
+  }
+  const std::vector<cv::KeyPoint>& kps_;
+  std::vector<int> scratch_;
+};
+
+}  // namespace
+
+std::vector<int> quadtree_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size) {
+  const int k = static_cast<int>(keypoints.size());
+  if (target <= 0 || k == 0) return {};
+  QuadTree tree(keypoints);
+  // Initial nodes: as many square-ish columns as the aspect ratio asks for (at least one).
+  const int n_ini = std::max(1, static_cast<int>(std::lround(static_cast<double>(size.width) / size.height)));
+  const float hx = static_cast<float>(size.width) / static_cast<float>(n_ini);
+  std::vector<std::vector<int>> columns(static_cast<std::size_t>(n_ini));
+  for (int i = 0; i < k; ++i) {
+    const int c = std::clamp(static_cast<int>(keypoints[static_cast<std::size_t>(i)].pt.x / hx), 0, n_ini - 1);
+    columns[static_cast<std::size_t>(c)].push_back(i);
+  }
+  std::vector<Node> nodes, next;
+  tree.idx_.reserve(static_cast<std::size_t>(k));
+  for (int c = 0; c < n_ini; ++c) {
+    const auto& col = columns[static_cast<std::size_t>(c)];
+    if (col.empty()) continue;
+    const int begin = static_cast<int>(tree.idx_.size());
+    tree.idx_.insert(tree.idx_.end(), col.begin(), col.end());
+    nodes.push_back({hx * static_cast<float>(c), 0.f, hx * static_cast<float>(c + 1), static_cast<float>(size.height),
+                     begin, static_cast<int>(tree.idx_.size())});
+  }
+
+  // Rounds where every node with more than one point splits, until the node count reaches the
+  // target; when a full round would overshoot, split the most populated nodes first (ORB-SLAM2).
+  bool finished = false;
+  while (!finished) {
+    next.clear();
+    int to_expand = 0;
+    for (const Node& n : nodes) {
+      if (n.size() <= 1) {
+        next.push_back(n);
+      } else {
+        to_expand += tree.split(n, next);
+      }
+    }
+    nodes.swap(next);
+    // ORB-SLAM2 stops when the node count did not change, which also stops when every point fell
+    // into one child; stopping only when no node can split any more is the intended criterion.
+    if (static_cast<int>(nodes.size()) >= target || to_expand == 0) break;
+    if (static_cast<int>(nodes.size()) + 3 * to_expand > target) {
+      while (!finished) {
+        // Largest first; stable so the result does not depend on the sort implementation.
+        std::vector<std::size_t> expandable;
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+          if (nodes[i].size() > 1) expandable.push_back(i);
+        if (expandable.empty()) break;
+        std::stable_sort(expandable.begin(), expandable.end(),
+                         [&](std::size_t a, std::size_t b) { return nodes[a].size() > nodes[b].size(); });
+        std::vector<char> removed(nodes.size(), 0);
+        std::vector<Node> added;
+        std::size_t count = nodes.size();
+        for (std::size_t i : expandable) {
+          const std::size_t children_before = added.size();
+          tree.split(nodes[i], added);
+          removed[i] = 1;
+          count += added.size() - children_before - 1;
+          if (static_cast<int>(count) >= target) {
+            finished = true;
+            break;
+          }
+        }
+        next.clear();
+        for (std::size_t i = 0; i < nodes.size(); ++i)
+          if (!removed[i]) next.push_back(nodes[i]);
+        next.insert(next.end(), added.begin(), added.end());
+        nodes.swap(next);
+      }
+    }
+  }
+
+  std::vector<int> kept;
+  kept.reserve(nodes.size());
+  for (const Node& n : nodes) {
+    int best = tree.idx_[static_cast<std::size_t>(n.begin)];
+    for (int i = n.begin + 1; i < n.end; ++i) {
+      const int id = tree.idx_[static_cast<std::size_t>(i)];
+      if (keypoints[static_cast<std::size_t>(id)].response > keypoints[static_cast<std::size_t>(best)].response) best = id;
+    }
+    kept.push_back(best);
+  }
+  std::stable_sort(kept.begin(), kept.end(), [&](int a, int b) {
+    return keypoints[static_cast<std::size_t>(a)].response > keypoints[static_cast<std::size_t>(b)].response;
+  });
+  if (static_cast<int>(kept.size()) > target) kept.resize(static_cast<std::size_t>(target));
+  return kept;
+}
+
+}  // namespace plslam::features

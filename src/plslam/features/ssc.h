@@ -1,0 +1,44 @@
+#pragma once
+// Suppression via Square Covering (SSC, Bailo et al. 2018): keeps about N strong keypoints
+// spread homogeneously over the image. Candidates are visited strongest first; a kept point
+// covers the grid cells around it, and covered candidates are dropped. The cover width w is
+// found by a binary search between closed-form bounds (derived in ssc.cpp).
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace plslam::features {
+
+struct SscBounds {
+  double low = 1;   // at or below this width at least N points survive (distinct integer pixels)
+  double high = 1;  // above this width fewer than N points can survive, whatever the input
+};
+
+// Bounds on the suppression width for `candidates` keypoints, N = `target`, image `size`.
+SscBounds ssc_width_bounds(int candidates, int target, cv::Size size);
+
+struct SscResult {
+  std::vector<int> kept;  // indices into the input, strongest first
+  double width = 0;       // width of the covering that produced `kept` (0: no suppression)
+  int iterations = 0;     // greedy passes run by the search
+};
+
+// Selects `target` (+- tolerance_fraction * target) keypoints out of `keypoints`, which lie in
+// [0, size.width) x [0, size.height). Any two kept points are more than `width` apart in the
+// max-norm. Deterministic: ties in response are broken by input order. When a search step
+// overshoots within the tolerance it is returned as is; when the search converges without
+// hitting the tolerance the best overshooting covering is cut to exactly `target` (the first
+// `target` kept points of a greedy pass are themselves a valid covering result).
+// `width_hint` (optional, > 0): a likely width, probed first together with its successor, so
+// that a good hint (e.g. the width found on the neighbouring pyramid level, where the per-level
+// target follows the level area and the width barely changes) ends the search after two passes.
+// The bisection between the closed-form bounds takes over when the hint is wrong; the result
+// depends on the hint only through which feasible width is found first.
+SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
+                     double tolerance_fraction = 0.001, double width_hint = 0);
+
+// Indices of `keypoints` sorted by decreasing response, ties by index (a counting sort when the
+// responses are small integers, as FAST scores are).
+std::vector<int> order_by_response(const std::vector<cv::KeyPoint>& keypoints);
+
+}  // namespace plslam::features

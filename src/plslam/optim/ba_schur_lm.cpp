@@ -1,0 +1,726 @@
+// The hand-written backend of bundle_adjust: Levenberg-Marquardt on the IRLS normal equations
+// with every landmark eliminated by the Schur complement. Why not Ceres: a local BA has ~40k tiny
+// residual blocks and Ceres' per-block bookkeeping costs several times the arithmetic; here each
+// observation is a handful of fixed-size Eigen products on contiguous arrays.
+//
+// Normal equations with IRLS weights w = info * rho'(s) per robust block (this is exactly what
+// Ceres does with a Huber loss: rho'' <= 0, so its corrector only rescales by sqrt(rho')):
+//     [ C   W ] [dc]   [-g_c]        C: 6x6 block per free keyframe
+//     [ W'  L ] [dl] = [-g_l]        L: 3x3 block per free point, 6x6 per free line
+// Reduced camera system  (C - W L^-1 W') dc = -(g_c - W L^-1 g_l), dense (6 n_cams)^2, LDLT;
+// back-substitution      dl = -L^-1 (g_l + W' dc).
+// Damping as Ceres' LM: lambda * clamp(diag(H), 1e-6, 1e32) on every block. It also keeps the
+// 6x6 line blocks invertible although their endpoints can slide along the 3D line (each block has
+// a 2-D null space; the gradient has no component there, so the damped step stays put).
+// Pose update on the left, T <- exp(dc) T, as the residual Jacobians assume.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <type_traits>
+
+#include <Eigen/Cholesky>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "plslam/optim/ba_pass.h"
+#include "plslam/optim/robust.h"
+#include "plslam/optim/stereo_line_residual.h"
+#include "plslam/optim/stereo_point_residual.h"
+
+namespace plslam::optim {
+namespace {
+
+using geometry::Matrix6d;
+using geometry::SE3;
+using geometry::Vector6d;
+
+// Ceres' LM defaults, so both backends stop in the same situations.
+constexpr double kMinDiagonal = 1e-6;
+constexpr double kMaxDiagonal = 1e32;
+constexpr double kInitialLambda = 1e-4;
+constexpr double kMinLambda = 1e-12;  // floor: the line gauge stays damped (Ceres: 1e-16)
+constexpr double kMaxLambda = 1e32;
+constexpr double kMinRelativeDecrease = 1e-3;
+constexpr double kGradientTolerance = 1e-10;
+constexpr double kParameterTolerance = 1e-8;
+
+double damping_diagonal(double h) { return std::clamp(h, kMinDiagonal, kMaxDiagonal); }
+
+// Inverse of a symmetric positive definite block; false when it is not positive definite.
+// 3x3 (points, most of the work): cofactors, with Sylvester's criterion as the definiteness test,
+// several times cheaper than a Cholesky solve against the identity.
+bool invert_spd(const Eigen::Matrix3d& A, Eigen::Matrix3d* inv) {
+  const double c00 = A(1, 1) * A(2, 2) - A(1, 2) * A(2, 1);
+  const double c01 = A(1, 2) * A(2, 0) - A(1, 0) * A(2, 2);
+  const double c02 = A(1, 0) * A(2, 1) - A(1, 1) * A(2, 0);
+  const double det = A(0, 0) * c00 + A(0, 1) * c01 + A(0, 2) * c02;
+  const double minor2 = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+  if (!(A(0, 0) > 0.0) || !(minor2 > 0.0) || !(det > 0.0)) return false;
+  const double id = 1.0 / det;
+  (*inv)(0, 0) = c00 * id;
+  (*inv)(1, 0) = (*inv)(0, 1) = c01 * id;
+  (*inv)(2, 0) = (*inv)(0, 2) = c02 * id;
+  (*inv)(1, 1) = (A(0, 0) * A(2, 2) - A(0, 2) * A(2, 0)) * id;
+  (*inv)(2, 1) = (*inv)(1, 2) = (A(0, 2) * A(1, 0) - A(0, 0) * A(1, 2)) * id;
+  (*inv)(2, 2) = minor2 * id;
+  return true;
+}
+
+bool invert_spd(const Matrix6d& A, Matrix6d* inv) {
+  const Eigen::LLT<Matrix6d> llt(A);
+  if (llt.info() != Eigen::Success) return false;
+  *inv = llt.solve(Matrix6d::Identity());
+  return true;
+}
+
+// One observation linearised: R residual rows, N landmark parameters; w holds the IRLS weight
+// (information included) of each row.
+template <int R, int N>
+struct Linearization {
+  Eigen::Matrix<double, R, 1> r, w;
+  Eigen::Matrix<double, R, 6> Jc;
+  Eigen::Matrix<double, R, N> Jl;
+};
+
+struct Context {
+  const geometry::StereoCamera& cam;
+  const BaOptions& opt;
+  bool robust;
+};
+
+// Sum of rho over the observation's robust blocks; false when a point is behind the camera.
+bool residual(const Context& c, const StereoPointObservation& o, double info, const SE3& T,
+              const Eigen::Vector3d& X, double* rho, Linearization<3, 3>* lin) {
+  Eigen::Vector3d r;
+  if (!evaluate_stereo_point(c.cam, T, X, o.measurement, o.has_right, &r,
+                             lin ? &lin->Jc : nullptr, lin ? &lin->Jl : nullptr)) {
+    return false;
+  }
+  const double s = info * r.squaredNorm();
+  const Huber h{o.has_right ? c.opt.chi2_point_stereo : c.opt.chi2_point_mono};
+  *rho = c.robust ? h.rho(s) : s;
+  if (lin) {
+    lin->r = r;
+    lin->w.setConstant(info * (c.robust ? h.weight(s) : 1.0));
+  }
+  return true;
+}
+
+bool residual(const Context& c, const StereoLineObservation& o, double info, const SE3& T,
+              const Vector6d& L, double* rho, Linearization<4, 6>* lin) {
+  Eigen::Vector4d r;
+  Matrix46d Jp;
+  Matrix43d Js, Je;
+  if (!evaluate_stereo_line(c.cam, T, L.head<3>(), L.tail<3>(), o, &r, lin ? &Jp : nullptr,
+                            lin ? &Js : nullptr, lin ? &Je : nullptr)) {
+    return false;
+  }
+  const Huber h{c.opt.chi2_line_pair};
+  *rho = 0.0;
+  for (int pair = 0; pair < 2; ++pair) {  // left image rows 0-1, right image rows 2-3
+    const double s = info * r.segment<2>(2 * pair).squaredNorm();
+    *rho += c.robust ? h.rho(s) : s;
+    if (lin) lin->w.segment<2>(2 * pair).setConstant(info * (c.robust ? h.weight(s) : 1.0));
+  }
+  if (lin) {
+    lin->r = r;
+    lin->Jc = Jp;
+    lin->Jl << Js, Je;
+  }
+  return true;
+}
+
+// Where the two landmark kinds differ: their arrays in the problem and in the state.
+struct PointKind {
+  static constexpr int R = 3, N = 3;
+  using Obs = StereoPointObservation;
+  using Vec = Eigen::Vector3d;
+  static const std::vector<Obs>& observations(const BaProblem& p) { return p.point_observations; }
+  static int landmark(const Obs& o) { return o.point; }
+  static bool fixed(const BaProblem& p, int i) { return p.points[static_cast<std::size_t>(i)].fixed; }
+  static std::size_t count(const BaProblem& p) { return p.points.size(); }
+  static std::vector<Vec>& values(BaState& s) { return s.points; }
+  static double info(const Obs& o, const BaOptions& opt) {
+    return level_information(o.level, opt.scale_factor);
+  }
+  static const std::vector<bool>* excluded(const BaExclusions* e) { return e ? &e->point_out : nullptr; }
+};
+
+struct LineKind {
+  static constexpr int R = 4, N = 6;
+  using Obs = StereoLineObservation;
+  using Vec = Vector6d;
+  static const std::vector<Obs>& observations(const BaProblem& p) { return p.line_observations; }
+  static int landmark(const Obs& o) { return o.line; }
+  static bool fixed(const BaProblem& p, int i) { return p.lines[static_cast<std::size_t>(i)].fixed; }
+  static std::size_t count(const BaProblem& p) { return p.lines.size(); }
+  static std::vector<Vec>& values(BaState& s) { return s.lines; }
+  static double info(const Obs& o, const BaOptions& opt) {
+    return o.information * level_information(o.level, opt.scale_factor);
+  }
+  static const std::vector<bool>* excluded(const BaExclusions* e) { return e ? &e->line_out : nullptr; }
+};
+
+struct ObsRef {
+  int obs;      // index into the problem's observation array
+  int kf;       // keyframe
+  int cam;      // free camera slot, -1 when the keyframe is fixed
+  double info;  // whitening weight
+};
+
+// The active observations of one landmark kind, grouped by free landmark (CSR), and the
+// per-landmark blocks of the current linearisation.
+template <class Kind>
+struct Groups {
+  static constexpr int N = Kind::N;
+  using MatN = Eigen::Matrix<double, N, N>;
+  using VecN = Eigen::Matrix<double, N, 1>;
+  using Mat6N = Eigen::Matrix<double, 6, N>;
+
+  std::vector<int> landmark;  // problem index of each free slot
+  std::vector<int> begin;     // slot i owns refs [begin[i], begin[i + 1])
+  std::vector<ObsRef> refs;
+  std::vector<ObsRef> fixed;  // observations of fixed landmarks: camera blocks and cost only
+  std::vector<Mat6N> W;       // per ref: w Jc' Jl
+  std::vector<MatN> H, Hinv;  // per slot: Jl' w Jl and the inverse of its damped version
+  std::vector<VecN> g, dx;    // per slot: gradient and step
+  // The linearisation at the candidate state, swapped in when the step is accepted.
+  std::vector<Mat6N> W_next;
+  std::vector<MatN> H_next;
+  std::vector<VecN> g_next;
+  int max_group = 0;
+
+  int slots() const { return static_cast<int>(landmark.size()); }
+  void swap_in_next() {
+    W.swap(W_next);
+    H.swap(H_next);
+    g.swap(g_next);
+  }
+};
+
+template <class Kind>
+Groups<Kind> make_groups(const BaProblem& p, const BaOptions& opt, const std::vector<bool>* out,
+                         const std::vector<int>& cam_of_kf) {
+  Groups<Kind> G;
+  const auto& obs = Kind::observations(p);
+  std::vector<int> slot_of(Kind::count(p), -1), counts;
+  for (std::size_t k = 0; k < obs.size(); ++k) {
+    if (out && (*out)[k]) continue;
+    const int l = Kind::landmark(obs[k]);
+    const ObsRef ref{static_cast<int>(k), obs[k].keyframe,
+                     cam_of_kf[static_cast<std::size_t>(obs[k].keyframe)], Kind::info(obs[k], opt)};
+    if (Kind::fixed(p, l)) {
+      G.fixed.push_back(ref);
+      continue;
+    }
+    int& slot = slot_of[static_cast<std::size_t>(l)];
+    if (slot < 0) {
+      slot = G.slots();
+      G.landmark.push_back(l);
+      counts.push_back(0);
+    }
+    ++counts[static_cast<std::size_t>(slot)];
+  }
+  G.begin.assign(counts.size() + 1, 0);
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    G.begin[i + 1] = G.begin[i] + counts[i];
+    G.max_group = std::max(G.max_group, counts[i]);
+  }
+  G.refs.resize(static_cast<std::size_t>(G.begin.back()));
+  std::vector<int> fill(G.begin.begin(), G.begin.end() - 1);
+  for (std::size_t k = 0; k < obs.size(); ++k) {
+    if (out && (*out)[k]) continue;
+    const int l = Kind::landmark(obs[k]);
+    if (Kind::fixed(p, l)) continue;
+    const int slot = slot_of[static_cast<std::size_t>(l)];
+    G.refs[static_cast<std::size_t>(fill[static_cast<std::size_t>(slot)]++)] = {
+        static_cast<int>(k), obs[k].keyframe, cam_of_kf[static_cast<std::size_t>(obs[k].keyframe)],
+        Kind::info(obs[k], opt)};
+  }
+  G.W.resize(G.refs.size());
+  G.W_next.resize(G.refs.size());
+  G.H.resize(counts.size());
+  G.H_next.resize(counts.size());
+  G.Hinv.resize(counts.size());
+  G.g.resize(counts.size());
+  G.g_next.resize(counts.size());
+  G.dx.resize(counts.size());
+  return G;
+}
+
+// Per-thread sums over observations: the camera part of the normal equations (upper block
+// triangle of H is used) and the robust cost.
+struct Accumulator {
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  double rho = 0.0;  // sum of rho: twice the cost
+  int failures = 0;  // observations behind a camera, or landmark blocks that failed to factor
+  // W L^-1 per ref of the landmark being eliminated (points, lines).
+  std::vector<Eigen::Matrix<double, 6, 3>> Y3;
+  std::vector<Eigen::Matrix<double, 6, 6>> Y6;
+
+  Accumulator(int n_cams, int max_group)
+      : H(Eigen::MatrixXd::Zero(6 * n_cams, 6 * n_cams)),
+        g(Eigen::VectorXd::Zero(6 * n_cams)),
+        Y3(static_cast<std::size_t>(max_group)),
+        Y6(static_cast<std::size_t>(max_group)) {}
+  auto& scratch(std::integral_constant<int, 3>) { return Y3; }
+  auto& scratch(std::integral_constant<int, 6>) { return Y6; }
+  void add(const Accumulator& o) {
+    H += o.H;
+    g += o.g;
+    rho += o.rho;
+    failures += o.failures;
+  }
+};
+
+// Work items of a pass over all observations: the free point slots, the free line slots, then the
+// observations of fixed points and of fixed lines, one item each.
+template <class PointGroups, class LineGroups, class SlotFn, class FixedFn>
+void dispatch(int item, PointGroups& points, LineGroups& lines, const SlotFn& slot_fn,
+              const FixedFn& fixed_fn) {
+  const int np = points.slots(), nl = lines.slots();
+  const int nfp = static_cast<int>(points.fixed.size());
+  if (item < np) return slot_fn(points, item);
+  item -= np;
+  if (item < nl) return slot_fn(lines, item);
+  item -= nl;
+  if (item < nfp) return fixed_fn(points, item);
+  fixed_fn(lines, item - nfp);
+}
+
+class SchurLm {
+ public:
+  SchurLm(const geometry::StereoCamera& cam, const BaProblem& p, const BaOptions& opt,
+          const BaPassSpec& spec, BaState* s)
+      : ctx_{cam, opt, spec.robust}, p_(p), opt_(opt), spec_(spec), s_(s),
+        threads_(std::max(1, opt.num_threads)) {
+    if (threads_ > 1) arena_ = std::make_unique<tbb::task_arena>(threads_);
+    build(spec.excluded);
+  }
+
+  BaPassSummary run();
+
+ private:
+  void build(const BaExclusions* excluded);
+  int max_group() const { return std::max(points_.max_group, lines_.max_group); }
+  int work_items() const {
+    return points_.slots() + lines_.slots() + static_cast<int>(points_.fixed.size()) +
+           static_cast<int>(lines_.fixed.size());
+  }
+  // Runs body(item, acc) over [0, n) with one accumulator per thread and returns their sum.
+  template <class Body>
+  Accumulator accumulate(int n, const Body& body) const;
+
+  // Linearises at `poses` and the landmarks (plus their step when with_step) into the *_next
+  // buffers; returns 2x the cost, infinity when an observation is behind its camera.
+  double linearize(const std::vector<SE3>& poses, bool with_step);
+  void swap_in_next();
+  bool solve(double lambda);
+  double model_decrease(double lambda) const;
+  void apply(std::vector<SE3> poses);
+  double state_norm() const;
+  double step_norm() const;
+  BaExclusions exclusions_with_invalid() const;
+
+  template <class Kind>
+  void linearize_slot(Groups<Kind>& G, int i, const std::vector<SE3>& poses, bool with_step,
+                      Accumulator& acc) const;
+  template <class Kind>
+  void linearize_fixed(const Groups<Kind>& G, int k, const std::vector<SE3>& poses,
+                       Accumulator& acc) const;
+  template <class Kind>
+  void eliminate_slot(Groups<Kind>& G, int i, double lambda, Accumulator& acc) const;
+  template <class Kind>
+  void back_substitute(Groups<Kind>& G, int i) const;
+
+  Context ctx_;
+  const BaProblem& p_;
+  const BaOptions& opt_;
+  const BaPassSpec& spec_;
+  BaState* s_;
+  int threads_;
+  mutable std::unique_ptr<tbb::task_arena> arena_;  // execute() is non-const
+
+  std::vector<int> cam_of_kf_;
+  std::vector<int> kf_of_cam_;
+  Groups<PointKind> points_;
+  Groups<LineKind> lines_;
+  // Current linearisation (camera part) and step.
+  Eigen::MatrixXd C_, C_next_;  // block diagonal, 6x6 per free camera
+  Eigen::VectorXd gc_, gc_next_, dc_;
+  double rho_ = 0.0;  // 2x cost at the current state
+};
+
+void SchurLm::build(const BaExclusions* excluded) {
+  // A keyframe gets a camera slot when it is free and observed by an active observation.
+  cam_of_kf_.assign(p_.keyframes.size(), -1);
+  kf_of_cam_.clear();
+  const auto mark = [&](int kf) {
+    const auto k = static_cast<std::size_t>(kf);
+    if (p_.keyframes[k].fixed || cam_of_kf_[k] >= 0) return;
+    cam_of_kf_[k] = static_cast<int>(kf_of_cam_.size());
+    kf_of_cam_.push_back(kf);
+  };
+  for (std::size_t k = 0; k < p_.point_observations.size(); ++k) {
+    if (!excluded || !excluded->point_out[k]) mark(p_.point_observations[k].keyframe);
+  }
+  for (std::size_t k = 0; k < p_.line_observations.size(); ++k) {
+    if (!excluded || !excluded->line_out[k]) mark(p_.line_observations[k].keyframe);
+  }
+  points_ = make_groups<PointKind>(p_, opt_, PointKind::excluded(excluded), cam_of_kf_);
+  lines_ = make_groups<LineKind>(p_, opt_, LineKind::excluded(excluded), cam_of_kf_);
+}
+
+template <class Body>
+Accumulator SchurLm::accumulate(int n, const Body& body) const {
+  const int n_cams = static_cast<int>(kf_of_cam_.size());
+  if (!arena_) {
+    Accumulator acc(n_cams, max_group());
+    for (int i = 0; i < n; ++i) body(i, acc);
+    return acc;
+  }
+  tbb::enumerable_thread_specific<Accumulator> local(n_cams, max_group());
+  arena_->execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, n, 64), [&](const tbb::blocked_range<int>& r) {
+      Accumulator& acc = local.local();
+      for (int i = r.begin(); i != r.end(); ++i) body(i, acc);
+    });
+  });
+  Accumulator total(n_cams, 0);
+  for (const Accumulator& acc : local) total.add(acc);
+  return total;
+}
+
+template <class Kind>
+void SchurLm::linearize_slot(Groups<Kind>& G, int i, const std::vector<SE3>& poses,
+                             bool with_step, Accumulator& acc) const {
+  constexpr int R = Kind::R, N = Kind::N;
+  const auto si = static_cast<std::size_t>(i);
+  const auto& obs = Kind::observations(p_);
+  typename Kind::Vec X = Kind::values(*s_)[static_cast<std::size_t>(G.landmark[si])];
+  if (with_step) X += G.dx[si];
+  auto& H = G.H_next[si];
+  auto& g = G.g_next[si];
+  H.setZero();
+  g.setZero();
+  Linearization<R, N> lin;
+  for (int k = G.begin[si]; k < G.begin[si + 1]; ++k) {
+    const ObsRef& ref = G.refs[static_cast<std::size_t>(k)];
+    double rho = 0.0;
+    if (!residual(ctx_, obs[static_cast<std::size_t>(ref.obs)], ref.info,
+                  poses[static_cast<std::size_t>(ref.kf)], X, &rho, &lin)) {
+      ++acc.failures;
+      continue;
+    }
+    acc.rho += rho;
+    const Eigen::Matrix<double, N, R> JlTw = lin.Jl.transpose() * lin.w.asDiagonal();
+    H.noalias() += JlTw * lin.Jl;
+    g.noalias() += JlTw * lin.r;
+    if (ref.cam < 0) continue;
+    const Eigen::Matrix<double, 6, R> JcTw = lin.Jc.transpose() * lin.w.asDiagonal();
+    acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam).noalias() += JcTw * lin.Jc;
+    acc.g.template segment<6>(6 * ref.cam).noalias() += JcTw * lin.r;
+    G.W_next[static_cast<std::size_t>(k)].noalias() = JcTw * lin.Jl;
+  }
+}
+
+template <class Kind>
+void SchurLm::linearize_fixed(const Groups<Kind>& G, int k, const std::vector<SE3>& poses,
+                              Accumulator& acc) const {
+  constexpr int R = Kind::R, N = Kind::N;
+  const ObsRef& ref = G.fixed[static_cast<std::size_t>(k)];
+  const auto& o = Kind::observations(p_)[static_cast<std::size_t>(ref.obs)];
+  const auto& X = Kind::values(*s_)[static_cast<std::size_t>(Kind::landmark(o))];
+  Linearization<R, N> lin;
+  double rho = 0.0;
+  if (!residual(ctx_, o, ref.info, poses[static_cast<std::size_t>(ref.kf)], X, &rho, &lin)) {
+    ++acc.failures;
+    return;
+  }
+  acc.rho += rho;
+  if (ref.cam < 0) return;
+  const Eigen::Matrix<double, 6, R> JcTw = lin.Jc.transpose() * lin.w.asDiagonal();
+  acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam).noalias() += JcTw * lin.Jc;
+  acc.g.template segment<6>(6 * ref.cam).noalias() += JcTw * lin.r;
+}
+
+double SchurLm::linearize(const std::vector<SE3>& poses, bool with_step) {
+  Accumulator acc = accumulate(work_items(), [&](int item, Accumulator& a) {
+    dispatch(
+        item, points_, lines_, [&](auto& G, int i) { linearize_slot(G, i, poses, with_step, a); },
+        [&](const auto& G, int k) { linearize_fixed(G, k, poses, a); });
+  });
+  C_next_ = std::move(acc.H);
+  gc_next_ = std::move(acc.g);
+  return acc.failures > 0 ? std::numeric_limits<double>::infinity() : acc.rho;
+}
+
+void SchurLm::swap_in_next() {
+  C_.swap(C_next_);
+  gc_.swap(gc_next_);
+  points_.swap_in_next();
+  lines_.swap_in_next();
+}
+
+template <class Kind>
+void SchurLm::eliminate_slot(Groups<Kind>& G, int i, double lambda, Accumulator& acc) const {
+  constexpr int N = Kind::N;
+  const auto si = static_cast<std::size_t>(i);
+  Eigen::Matrix<double, N, N> Hd = G.H[si];
+  for (int j = 0; j < N; ++j) Hd(j, j) += lambda * damping_diagonal(G.H[si](j, j));
+  if (!invert_spd(Hd, &G.Hinv[si])) {
+    ++acc.failures;
+    return;
+  }
+  const auto& Hinv = G.Hinv[si];
+  const int b = G.begin[si], e = G.begin[si + 1];
+  auto& Ys = acc.scratch(std::integral_constant<int, N>());
+  // Y_a = W_a L^-1, then S -= Y_a W_c' for c >= a (upper block triangle), products written
+  // straight into S.
+  for (int a = b; a < e; ++a) {
+    const ObsRef& ra = G.refs[static_cast<std::size_t>(a)];
+    if (ra.cam < 0) continue;
+    auto& Y = Ys[static_cast<std::size_t>(a - b)];
+    Y.noalias() = G.W[static_cast<std::size_t>(a)] * Hinv;
+    acc.g.template segment<6>(6 * ra.cam).noalias() -= Y * G.g[si];
+  }
+  for (int a = b; a < e; ++a) {
+    const int ca = G.refs[static_cast<std::size_t>(a)].cam;
+    if (ca < 0) continue;
+    const auto& Ya = Ys[static_cast<std::size_t>(a - b)];
+    const auto& Wa = G.W[static_cast<std::size_t>(a)];
+    for (int c = a; c < e; ++c) {
+      const int cc = G.refs[static_cast<std::size_t>(c)].cam;
+      if (cc < 0) continue;
+      if (ca <= cc) {
+        acc.H.block<6, 6>(6 * ca, 6 * cc).noalias() -= Ya * G.W[static_cast<std::size_t>(c)].transpose();
+      } else {  // (Y_a W_c')' = Y_c W_a' since W L^-1 W' is symmetric
+        acc.H.block<6, 6>(6 * cc, 6 * ca).noalias() -= Ys[static_cast<std::size_t>(c - b)] * Wa.transpose();
+      }
+      if (ca == cc && a != c) {  // the same keyframe observes the landmark twice: both orders
+        acc.H.block<6, 6>(6 * ca, 6 * ca).noalias() -= Ys[static_cast<std::size_t>(c - b)] * Wa.transpose();
+      }
+    }
+  }
+}
+
+template <class Kind>
+void SchurLm::back_substitute(Groups<Kind>& G, int i) const {
+  const auto si = static_cast<std::size_t>(i);
+  Eigen::Matrix<double, Kind::N, 1> rhs = G.g[si];
+  for (int a = G.begin[si]; a < G.begin[si + 1]; ++a) {
+    const int c = G.refs[static_cast<std::size_t>(a)].cam;
+    if (c >= 0) rhs.noalias() += G.W[static_cast<std::size_t>(a)].transpose() * dc_.segment<6>(6 * c);
+  }
+  G.dx[si].noalias() = -(G.Hinv[si] * rhs);
+}
+
+bool SchurLm::solve(double lambda) {
+  const int n_slots = points_.slots() + lines_.slots();
+  Accumulator acc = accumulate(n_slots, [this, lambda](int item, Accumulator& a) {
+    if (item < points_.slots()) {
+      eliminate_slot(points_, item, lambda, a);
+    } else {
+      eliminate_slot(lines_, item - points_.slots(), lambda, a);
+    }
+  });
+  if (acc.failures > 0) return false;
+  const auto n = C_.rows();
+  if (n > 0) {
+    Eigen::MatrixXd S = C_ + acc.H;
+    for (Eigen::Index j = 0; j < n; ++j) S(j, j) += lambda * damping_diagonal(C_(j, j));
+    S.triangularView<Eigen::StrictlyLower>() = S.transpose();
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+    if (ldlt.info() != Eigen::Success) return false;
+    dc_ = ldlt.solve(-(gc_ + acc.g));
+    if (!dc_.allFinite()) return false;
+  } else {
+    dc_.resize(0);
+  }
+  bool finite = true;
+  for (int i = 0; i < points_.slots(); ++i) {
+    back_substitute(points_, i);
+    finite = finite && points_.dx[static_cast<std::size_t>(i)].allFinite();
+  }
+  for (int i = 0; i < lines_.slots(); ++i) {
+    back_substitute(lines_, i);
+    finite = finite && lines_.dx[static_cast<std::size_t>(i)].allFinite();
+  }
+  return finite;
+}
+
+// L(0) - L(dx) of the quadratic model; with (H + lambda D) dx = -g this is
+// (lambda dx' D dx - g' dx) / 2, all blocks summed.
+double SchurLm::model_decrease(double lambda) const {
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < dc_.size(); ++j) {
+    sum += lambda * damping_diagonal(C_(j, j)) * dc_(j) * dc_(j) - gc_(j) * dc_(j);
+  }
+  const auto add = [&](const auto& G) {
+    for (std::size_t i = 0; i < G.dx.size(); ++i) {
+      for (int j = 0; j < G.N; ++j) {
+        sum += lambda * damping_diagonal(G.H[i](j, j)) * G.dx[i](j) * G.dx[i](j) -
+               G.g[i](j) * G.dx[i](j);
+      }
+    }
+  };
+  add(points_);
+  add(lines_);
+  return 0.5 * sum;
+}
+
+void SchurLm::apply(std::vector<SE3> poses) {
+  s_->poses = std::move(poses);
+  const auto add = [&](auto& G, auto& values) {
+    for (std::size_t i = 0; i < G.dx.size(); ++i) {
+      values[static_cast<std::size_t>(G.landmark[i])] += G.dx[i];
+    }
+  };
+  add(points_, s_->points);
+  add(lines_, s_->lines);
+}
+
+double SchurLm::state_norm() const {
+  double sq = 0.0;
+  for (const int kf : kf_of_cam_) {
+    sq += s_->poses[static_cast<std::size_t>(kf)].translation().squaredNorm() + 1.0;  // + |q|^2
+  }
+  for (const int l : points_.landmark) sq += s_->points[static_cast<std::size_t>(l)].squaredNorm();
+  for (const int l : lines_.landmark) sq += s_->lines[static_cast<std::size_t>(l)].squaredNorm();
+  return std::sqrt(sq);
+}
+
+double SchurLm::step_norm() const {
+  double sq = dc_.squaredNorm();
+  for (const auto& d : points_.dx) sq += d.squaredNorm();
+  for (const auto& d : lines_.dx) sq += d.squaredNorm();
+  return std::sqrt(sq);
+}
+
+BaExclusions SchurLm::exclusions_with_invalid() const {
+  BaExclusions ex;
+  ex.point_out.assign(p_.point_observations.size(), false);
+  ex.line_out.assign(p_.line_observations.size(), false);
+  if (spec_.excluded) ex = *spec_.excluded;
+  Linearization<3, 3>* no_point = nullptr;
+  Linearization<4, 6>* no_line = nullptr;
+  double rho = 0.0;
+  for (std::size_t k = 0; k < p_.point_observations.size(); ++k) {
+    const auto& o = p_.point_observations[k];
+    ex.point_out[k] = ex.point_out[k] ||
+                      !residual(ctx_, o, 1.0, s_->poses[static_cast<std::size_t>(o.keyframe)],
+                                s_->points[static_cast<std::size_t>(o.point)], &rho, no_point);
+  }
+  for (std::size_t k = 0; k < p_.line_observations.size(); ++k) {
+    const auto& o = p_.line_observations[k];
+    ex.line_out[k] = ex.line_out[k] ||
+                     !residual(ctx_, o, 1.0, s_->poses[static_cast<std::size_t>(o.keyframe)],
+                               s_->lines[static_cast<std::size_t>(o.line)], &rho, no_line);
+  }
+  return ex;
+}
+
+BaPassSummary SchurLm::run() {
+  BaPassSummary out;
+  int dropped = 0;
+  rho_ = linearize(s_->poses, false);
+  if (!std::isfinite(rho_)) {
+    // Observations behind their camera at the start are left out of this pass (Ceres would
+    // refuse to start); the final gate flags them as outliers.
+    const BaExclusions ex = exclusions_with_invalid();
+    for (const bool b : ex.point_out) dropped += b;
+    for (const bool b : ex.line_out) dropped += b;
+    build(&ex);
+    rho_ = linearize(s_->poses, false);
+  }
+  swap_in_next();
+  out.initial_cost = out.final_cost = 0.5 * rho_;
+  if (points_.refs.empty() && lines_.refs.empty() && points_.fixed.empty() && lines_.fixed.empty()) {
+    out.message = "no observations";  // not usable: nothing was optimised
+    return out;
+  }
+  double lambda = kInitialLambda, nu = 2.0;
+  int accepted = 0;
+  const char* why = "iteration limit";
+  while (out.iterations < spec_.iterations) {
+    if (gc_.size() == 0 && points_.slots() == 0 && lines_.slots() == 0) {
+      why = "nothing free";
+      break;
+    }
+    double gmax = gc_.size() > 0 ? gc_.cwiseAbs().maxCoeff() : 0.0;
+    for (const auto& g : points_.g) gmax = std::max(gmax, g.cwiseAbs().maxCoeff());
+    for (const auto& g : lines_.g) gmax = std::max(gmax, g.cwiseAbs().maxCoeff());
+    if (gmax <= kGradientTolerance) {
+      why = "gradient tolerance";
+      break;
+    }
+    ++out.iterations;
+    if (!solve(lambda)) {  // a damped block was not positive definite: damp more
+      lambda *= nu;
+      nu *= 2.0;
+      if (lambda > kMaxLambda) {
+        why = "damping limit";
+        break;
+      }
+      continue;
+    }
+    if (step_norm() <= kParameterTolerance * (state_norm() + kParameterTolerance)) {
+      why = "parameter tolerance";
+      break;
+    }
+    std::vector<SE3> poses = s_->poses;
+    for (std::size_t c = 0; c < kf_of_cam_.size(); ++c) {
+      auto& T = poses[static_cast<std::size_t>(kf_of_cam_[c])];
+      T = SE3::exp(dc_.segment<6>(6 * static_cast<Eigen::Index>(c))) * T;
+    }
+    const double rho_new = linearize(poses, true);  // the next linearisation if accepted
+    const double decrease = 0.5 * (rho_ - rho_new);
+    const double model = model_decrease(lambda);
+    const double ratio = decrease / model;
+    const bool converged = std::isfinite(rho_new) && std::abs(decrease) <= opt_.function_tolerance * 0.5 * rho_;
+    if (std::isfinite(rho_new) && model > 0.0 && ratio > kMinRelativeDecrease) {
+      apply(std::move(poses));
+      swap_in_next();
+      rho_ = rho_new;
+      ++accepted;
+      lambda = std::max(kMinLambda, lambda * std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * ratio - 1.0, 3)));
+      nu = 2.0;
+    } else {
+      lambda *= nu;
+      nu *= 2.0;
+    }
+    if (converged) {
+      why = "function tolerance";
+      break;
+    }
+    if (lambda > kMaxLambda) {
+      why = "damping limit";
+      break;
+    }
+  }
+  out.final_cost = 0.5 * rho_;
+  out.usable = std::isfinite(out.final_cost);
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "Schur LM: %d iterations (%d accepted), cost %.6e -> %.6e, lambda %.1e, %s; "
+                "%d cameras, %d points, %d lines, %d observations dropped behind a camera",
+                out.iterations, accepted, out.initial_cost, out.final_cost, lambda, why,
+                static_cast<int>(kf_of_cam_.size()), points_.slots(), lines_.slots(), dropped);
+  out.message = buf;
+  return out;
+}
+
+}  // namespace
+
+BaPassSummary schur_lm_ba_pass(const geometry::StereoCamera& cam, const BaProblem& p,
+                               const BaOptions& opt, const BaPassSpec& spec, BaState* s) {
+  return SchurLm(cam, p, opt, spec, s).run();
+}
+
+}  // namespace plslam::optim

@@ -1,0 +1,82 @@
+#pragma once
+// A synthetic stereo sequence: scene + camera preset + trajectory + sensor model. Frames are
+// rendered on demand and independently (any order, any thread with its own StereoRenderer),
+// and always give the same bytes for the same options.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "plslam/core/types.h"
+#include "plslam/synth/renderer.h"
+#include "plslam/synth/scene.h"
+#include "plslam/synth/sensor.h"
+#include "plslam/synth/trajectory.h"
+
+namespace plslam::synth {
+
+struct CameraPreset {
+  std::string name;
+  int width, height;
+  double fps;
+  double fx, fy, cx, cy;
+  double baseline;  // metres
+};
+
+CameraPreset euroc_preset();  // 752x480, 20 Hz, fx 458, baseline 0.11 m
+CameraPreset kitti_preset();  // 1241x376, 10 Hz, fx 718, baseline 0.54 m
+CameraPreset parse_preset(const std::string& name);  // euroc|kitti; InputError otherwise
+
+struct SequenceOptions {
+  SceneKind scene = SceneKind::kOffice;
+  CameraPreset preset = euroc_preset();
+  int frames = 200;
+  std::uint64_t seed = 1;
+  bool loop = false;         // traverse the whole closed path (>= 30 m) and return to the start
+  bool motion_blur = false;  // integrate over the shutter time, proportional to the motion
+};
+
+class Sequence {
+ public:
+  explicit Sequence(const SequenceOptions& options);  // throws InputError on bad options
+
+  const SequenceOptions& options() const { return options_; }
+  const Scene& scene() const { return scene_; }
+  const CameraPath& path() const { return path_; }
+  const SensorModel& sensor() const { return sensor_; }
+  StereoCalibration calibration() const;
+  PinholeCamera camera() const;
+  std::size_t size() const { return static_cast<std::size_t>(options_.frames); }
+  double time(std::size_t i) const { return static_cast<double>(i) / options_.preset.fps; }
+  Eigen::Isometry3d left_pose(std::size_t i) const { return path_.pose(time(i)); }  // T_world_left
+  Eigen::Isometry3d right_pose(std::size_t i) const;
+
+ private:
+  SequenceOptions options_;
+  Scene scene_;
+  CameraPath path_;
+  SensorModel sensor_;
+};
+
+struct StereoImages {
+  cv::Mat left, right;              // CV_8U
+  cv::Mat left_depth, right_depth;  // CV_32F metres (only when requested)
+};
+
+// Per-thread rendering state (z-buffers) for one sequence.
+class StereoRenderer {
+ public:
+  explicit StereoRenderer(const Sequence& sequence);
+  StereoImages render(std::size_t i, bool with_depth = false);
+
+ private:
+  void render_camera(const Eigen::Isometry3d& T_lr, std::size_t i, cv::Mat& radiance, cv::Mat* depth);
+
+  const Sequence& seq_;
+  Renderer renderer_;
+  cv::Mat radiance_, accum_;
+};
+
+}  // namespace plslam::synth

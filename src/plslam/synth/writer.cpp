@@ -1,0 +1,208 @@
+#include "plslam/synth/writer.h"
+
+#include <atomic>
+#include <fstream>
+#include <mutex>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include "plslam/core/error.h"
+#include "plslam/io/trajectory_io.h"
+
+namespace plslam::synth {
+
+namespace fs = std::filesystem;
+
+OutputFormat parse_output_format(const std::string& name) {
+  if (name == "euroc") return OutputFormat::kEuroc;
+  if (name == "kitti") return OutputFormat::kKitti;
+  throw InputError("", "unknown format '" + name + "' (expected euroc or kitti)");
+}
+
+Eigen::Isometry3d euroc_T_BS_cam0() {
+  // Body: x forward, y left, z up (IMU-like). The camera looks along body x, slightly rotated
+  // and offset like a real rig, so consumers must really apply T_BS.
+  Eigen::Matrix3d R_nominal;
+  R_nominal << 0, 0, 1,   // camera z (forward) -> body x
+      -1, 0, 0,           // camera x (right)   -> body -y
+      0, -1, 0;           // camera y (down)    -> body -z
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-0.015, Eigen::Vector3d::UnitY()))
+                   .toRotationMatrix() *
+               R_nominal;
+  T.translation() = Eigen::Vector3d(0.065, 0.02, -0.01);
+  return T;
+}
+
+std::int64_t euroc_timestamp_ns(const Sequence& seq, std::size_t i) {
+  // Start at 1 s so times stay exactly representable as double seconds.
+  return 1'000'000'000LL + std::llround(static_cast<double>(i) * 1e9 / seq.options().preset.fps);
+}
+
+namespace {
+
+std::ofstream open_out(const fs::path& p) {
+  fs::create_directories(p.parent_path());
+  std::ofstream out(p);
+  if (!out) throw InputError(p.string(), "cannot open for writing");
+  return out;
+}
+
+void write_png(const fs::path& p, const cv::Mat& img) {
+  if (!cv::imwrite(p.string(), img)) throw InputError(p.string(), "cannot write image");
+}
+
+std::string matrix_yaml(const Eigen::Isometry3d& T) {
+  const Eigen::Matrix4d M = T.matrix();
+  std::string s = "  cols: 4\n  rows: 4\n  data: [";
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      s += fmt::format("{:.17g}", M(r, c));
+      if (r < 3 || c < 3) s += ", ";
+    }
+    if (r < 3) s += "\n         ";
+  }
+  return s + "]\n";
+}
+
+void write_sensor_yaml(const fs::path& p, const Sequence& seq, const Eigen::Isometry3d& T_BS, int cam) {
+  const auto& pr = seq.options().preset;
+  auto out = open_out(p);
+  out << "%YAML:1.0\n# General sensor definitions.\nsensor_type: camera\n"
+      << "comment: plslam synth cam" << cam << " (ideal rectified pinhole)\n\n"
+      << "# Sensor extrinsics wrt. the body-frame.\nT_BS:\n" << matrix_yaml(T_BS) << "\n"
+      << "# Camera specific definitions.\n"
+      << fmt::format("rate_hz: {}\n", pr.fps) << fmt::format("resolution: [{}, {}]\n", pr.width, pr.height)
+      << "camera_model: pinhole\n"
+      << fmt::format("intrinsics: [{:.17g}, {:.17g}, {:.17g}, {:.17g}] #fu, fv, cu, cv\n", pr.fx, pr.fy, pr.cx, pr.cy)
+      << "distortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n";
+}
+
+void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const Eigen::Isometry3d& T_out_world,
+                               const std::vector<double>& times, const char* frame_name) {
+  {
+    auto out = open_out(dir / "segments_3d.txt");
+    out << "# x1 y1 z1 x2 y2 z2 [m], straight scene edges, frame: " << frame_name << "\n";
+    for (const Segment3d& s : seq.scene().edges()) {
+      const Eigen::Vector3d a = T_out_world * s.a, b = T_out_world * s.b;
+      out << fmt::format("{:.9g} {:.9g} {:.9g} {:.9g} {:.9g} {:.9g}\n", a.x(), a.y(), a.z(), b.x(), b.y(), b.z());
+    }
+  }
+  {
+    auto out = open_out(dir / "points_3d.txt");
+    out << "# x y z [m], points on scene surfaces, frame: " << frame_name << "\n";
+    for (const Eigen::Vector3d& p : seq.scene().sample_points(4, seq.options().seed)) {
+      const Eigen::Vector3d q = T_out_world * p;
+      out << fmt::format("{:.9g} {:.9g} {:.9g}\n", q.x(), q.y(), q.z());
+    }
+  }
+  Trajectory left;
+  for (std::size_t i = 0; i < seq.size(); ++i) left.push_back({times[i], T_out_world * seq.left_pose(i)});
+  io::write_trajectory(dir / "left_camera.tum", left, io::TrajectoryFormat::kTum);
+  const auto& o = seq.options();
+  nlohmann::json j = {{"scene", to_string(o.scene)}, {"preset", o.preset.name}, {"frames", o.frames},
+                      {"seed", o.seed},   {"loop", o.loop},  {"motion_blur", o.motion_blur},
+                      {"fps", o.preset.fps}, {"width", o.preset.width}, {"height", o.preset.height},
+                      {"fx", o.preset.fx}, {"fy", o.preset.fy}, {"cx", o.preset.cx}, {"cy", o.preset.cy},
+                      {"baseline_m", o.preset.baseline}, {"path_length_m", seq.path().length()},
+                      {"speed_mps", seq.path().speed()}, {"frame", frame_name}};
+  open_out(dir / "synth.json") << j.dump(2) << "\n";
+}
+
+void render_all(const Sequence& seq, const Progress& progress, int threads,
+                const std::function<void(std::size_t, const StereoImages&)>& sink) {
+  const std::size_t n = seq.size();
+  std::atomic<std::size_t> done{0};
+  std::mutex mu;
+  auto body = [&](const tbb::blocked_range<std::size_t>& r) {
+    StereoRenderer renderer(seq);
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      sink(i, renderer.render(i));
+      const std::size_t d = ++done;
+      if (progress) {
+        std::lock_guard<std::mutex> lock(mu);
+        progress(d, n);
+      }
+    }
+  };
+  if (threads == 1) {
+    body(tbb::blocked_range<std::size_t>(0, n));
+    return;
+  }
+  std::unique_ptr<tbb::global_control> limit;
+  if (threads > 1) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8), body);
+}
+
+}  // namespace
+
+void write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat format, const Progress& progress,
+                    int threads) {
+  const std::size_t n = seq.size();
+  if (format == OutputFormat::kEuroc) {
+    const fs::path mav = dir / "mav0";
+    const Eigen::Isometry3d T_BS0 = euroc_T_BS_cam0();
+    Eigen::Isometry3d T_c0c1 = Eigen::Isometry3d::Identity();
+    T_c0c1.translation().x() = seq.options().preset.baseline;
+    std::vector<double> times;
+    for (int cam = 0; cam < 2; ++cam) {
+      const fs::path cdir = mav / fmt::format("cam{}", cam);
+      fs::create_directories(cdir / "data");
+      auto csv = open_out(cdir / "data.csv");
+      csv << "#timestamp [ns],filename\n";
+      for (std::size_t i = 0; i < n; ++i) csv << fmt::format("{0},{0}.png\n", euroc_timestamp_ns(seq, i));
+      write_sensor_yaml(cdir / "sensor.yaml", seq, cam == 0 ? T_BS0 : T_BS0 * T_c0c1, cam);
+    }
+    Trajectory body;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double t = static_cast<double>(euroc_timestamp_ns(seq, i)) * 1e-9;
+      times.push_back(t);
+      body.push_back({t, seq.left_pose(i) * T_BS0.inverse()});  // T_wb = T_wc * T_cb
+    }
+    io::write_trajectory(mav / "state_groundtruth_estimate0" / "data.csv", body, io::TrajectoryFormat::kEuroc);
+    render_all(seq, progress, threads, [&](std::size_t i, const StereoImages& im) {
+      const std::string name = fmt::format("{}.png", euroc_timestamp_ns(seq, i));
+      write_png(mav / "cam0" / "data" / name, im.left);
+      write_png(mav / "cam1" / "data" / name, im.right);
+    });
+    // Last, so that synth/synth.json marks a complete sequence.
+    write_ground_truth_extras(seq, mav / "synth", Eigen::Isometry3d::Identity(), times, "euroc world (z up)");
+    return;
+  }
+  const fs::path sdir = dir / "sequences" / "00";
+  fs::create_directories(sdir / "image_0");
+  fs::create_directories(sdir / "image_1");
+  const auto& pr = seq.options().preset;
+  {
+    auto calib = open_out(sdir / "calib.txt");
+    for (int cam = 0; cam < 2; ++cam) {
+      const double tx = cam == 0 ? 0.0 : -pr.fx * pr.baseline;
+      calib << fmt::format("P{}: {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}\n",
+                           cam, pr.fx, 0.0, pr.cx, tx, 0.0, pr.fy, pr.cy, 0.0, 0.0, 0.0, 1.0, 0.0);
+    }
+  }
+  std::vector<double> times;
+  {
+    auto out = open_out(sdir / "times.txt");
+    for (std::size_t i = 0; i < n; ++i) {
+      times.push_back(seq.time(i));
+      out << fmt::format("{:.6e}\n", seq.time(i));
+    }
+  }
+  const Eigen::Isometry3d T_0w = seq.left_pose(0).inverse();
+  Trajectory poses;
+  for (std::size_t i = 0; i < n; ++i) poses.push_back({times[i], T_0w * seq.left_pose(i)});
+  poses[0].T = Eigen::Isometry3d::Identity();  // exactly, not up to rounding
+  io::write_trajectory(dir / "poses" / "00.txt", poses, io::TrajectoryFormat::kKitti);
+  render_all(seq, progress, threads, [&](std::size_t i, const StereoImages& im) {
+    write_png(sdir / "image_0" / fmt::format("{:06d}.png", i), im.left);
+    write_png(sdir / "image_1" / fmt::format("{:06d}.png", i), im.right);
+  });
+  write_ground_truth_extras(seq, sdir / "synth", T_0w, times, "kitti first left camera");
+}
+
+}  // namespace plslam::synth

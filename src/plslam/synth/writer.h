@@ -1,0 +1,44 @@
+#pragma once
+// Writes a Sequence to disk in the layout of a real dataset, plus extra ground truth:
+//
+//   EuRoC (--format euroc):
+//     DIR/mav0/cam{0,1}/data.csv, data/<ns>.png, sensor.yaml   (exactly the ASL layout)
+//     DIR/mav0/state_groundtruth_estimate0/data.csv           (body = IMU-like frame)
+//     DIR/mav0/synth/                                         (extra ground truth, below)
+//   KITTI (--format kitti):
+//     DIR/sequences/00/{image_0,image_1}/NNNNNN.png, calib.txt, times.txt
+//     DIR/poses/00.txt                                        (left camera, first pose identity)
+//     DIR/sequences/00/synth/                                 (extra ground truth, below)
+//
+//   synth/segments_3d.txt   "x1 y1 z1 x2 y2 z2" per line: every straight scene edge
+//   synth/points_3d.txt     "x y z" per line: surface sample points
+//   synth/left_camera.tum   TUM poses of the left camera (T_world_left) at the image times
+//   synth/synth.json        the options (scene, preset, seed, loop, ...) and the frame used;
+//                           written last, so its presence marks a complete sequence
+// All synth/ coordinates are in the frame of that layout's ground truth: the EuRoC world
+// (z up) or, for KITTI, the first left camera.
+#include <filesystem>
+#include <functional>
+
+#include <Eigen/Geometry>
+
+#include "plslam/synth/sequence.h"
+
+namespace plslam::synth {
+
+enum class OutputFormat { kEuroc, kKitti };
+OutputFormat parse_output_format(const std::string& name);  // euroc|kitti; InputError otherwise
+
+// Sensor-to-body transform of cam0 used in the EuRoC layout (p_body = T_BS * p_cam0).
+Eigen::Isometry3d euroc_T_BS_cam0();
+// EuRoC image timestamp of frame i in nanoseconds.
+std::int64_t euroc_timestamp_ns(const Sequence& seq, std::size_t i);
+
+// Called after each frame is written with (frames done, total).
+using Progress = std::function<void(std::size_t, std::size_t)>;
+
+// Renders every frame (in parallel when `threads` != 1) and writes the dataset.
+void write_sequence(const Sequence& seq, const std::filesystem::path& dir, OutputFormat format,
+                    const Progress& progress = {}, int threads = 0);
+
+}  // namespace plslam::synth

@@ -1,0 +1,191 @@
+// SSC: exact count within tolerance, pairwise spacing above the final width, homogeneity,
+// determinism, and the closed-form width bounds.
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "plslam/features/keypoint_uniformity.h"
+#include "plslam/features/ssc.h"
+
+namespace plslam::features {
+namespace {
+
+// Distinct integer positions with integer FAST-like scores; `clustered` puts 80 % of them,
+// with the highest scores, in the top-left quarter.
+std::vector<cv::KeyPoint> random_keypoints(int n, cv::Size size, uint32_t seed, bool clustered = false) {
+  std::mt19937 rng(seed);
+  std::set<std::pair<int, int>> used;
+  std::vector<cv::KeyPoint> kps;
+  while (static_cast<int>(kps.size()) < n) {
+    const bool in_cluster = clustered && static_cast<int>(kps.size()) < n * 8 / 10;
+    const int w = in_cluster ? size.width / 4 : size.width, h = in_cluster ? size.height / 4 : size.height;
+    const int x = static_cast<int>(rng() % static_cast<uint32_t>(w));
+    const int y = static_cast<int>(rng() % static_cast<uint32_t>(h));
+    if (!used.insert({x, y}).second) continue;
+    const float score = in_cluster ? static_cast<float>(150 + rng() % 100) : static_cast<float>(7 + rng() % 140);
+    kps.emplace_back(cv::Point2f(static_cast<float>(x), static_cast<float>(y)), 7.f, -1.f, score);
+  }
+  return kps;
+}
+
+double min_max_norm_distance(const std::vector<cv::KeyPoint>& kps, const std::vector<int>& idx) {
+  double best = 1e9;
+  for (std::size_t a = 0; a < idx.size(); ++a)
+    for (std::size_t b = a + 1; b < idx.size(); ++b) {
+      const auto& p = kps[static_cast<std::size_t>(idx[a])].pt;
+      const auto& q = kps[static_cast<std::size_t>(idx[b])].pt;
+      best = std::min(best, static_cast<double>(std::max(std::abs(p.x - q.x), std::abs(p.y - q.y))));
+    }
+  return best;
+}
+
+std::vector<cv::KeyPoint> subset(const std::vector<cv::KeyPoint>& kps, const std::vector<int>& idx) {
+  std::vector<cv::KeyPoint> out;
+  for (int i : idx) out.push_back(kps[static_cast<std::size_t>(i)]);
+  return out;
+}
+
+TEST(Ssc, CountWithinToleranceAndSpacingAboveWidth) {
+  const cv::Size size(752, 480);
+  for (const int target : {50, 387, 1200, 3000}) {
+    const auto kps = random_keypoints(12000, size, 1u + static_cast<uint32_t>(target));
+    const SscResult r = ssc_select(kps, target, size);
+    const int tolerance = static_cast<int>(std::floor(0.001 * target));
+    EXPECT_LE(std::abs(static_cast<int>(r.kept.size()) - target), tolerance) << "target " << target;
+    ASSERT_GT(r.width, 0.0);
+    // Kept points are pairwise more than w apart in the max-norm (the grid gives exactly that).
+    EXPECT_GT(min_max_norm_distance(kps, r.kept), r.width) << "target " << target;
+    const SscBounds b = ssc_width_bounds(12000, target, size);
+    EXPECT_GE(r.width, std::floor(b.low));
+    EXPECT_LE(r.width, std::ceil(b.high));
+    // The search ends near the widest feasible cover, not at a tiny width (the bound assumes a
+    // perfect lattice; greedy covers of 10x more candidates reach about 60-80 % of it).
+    if (target <= 1200) {
+      EXPECT_GT(r.width, 0.5 * b.high) << "target " << target;
+    }
+    // Strongest first.
+    for (std::size_t i = 1; i < r.kept.size(); ++i)
+      EXPECT_GE(kps[static_cast<std::size_t>(r.kept[i - 1])].response, kps[static_cast<std::size_t>(r.kept[i])].response);
+  }
+}
+
+TEST(Ssc, SpreadsClusteredStrongPointsOverTheImage) {
+  const cv::Size size(752, 480);
+  const auto kps = random_keypoints(10000, size, 3u, /*clustered=*/true);
+  const int target = 400;
+  const SscResult r = ssc_select(kps, target, size);
+  ASSERT_EQ(static_cast<int>(r.kept.size()), target);
+  // Top-N by score lands almost entirely in the cluster quarter; SSC fills the whole image.
+  std::vector<int> order = order_by_response(kps);
+  order.resize(static_cast<std::size_t>(target));
+  const double cv_top = grid_count_cv(subset(kps, order), size);
+  const double cv_ssc = grid_count_cv(subset(kps, r.kept), size);
+  EXPECT_GT(cv_top, 1.5);
+  EXPECT_LT(cv_ssc, 0.6);
+  int in_cluster = 0;
+  for (int i : r.kept)
+    if (kps[static_cast<std::size_t>(i)].pt.x < size.width / 4 && kps[static_cast<std::size_t>(i)].pt.y < size.height / 4) ++in_cluster;
+  // The cluster quarter is 1/16 of the image; allow twice its share.
+  EXPECT_LT(in_cluster, target * 2 / 16);
+}
+
+TEST(Ssc, DeterministicAndIndependentOfInputOrder) {
+  const cv::Size size(640, 480);
+  auto kps = random_keypoints(8000, size, 5u);
+  // Distinct responses so the order of the input cannot matter.
+  for (std::size_t i = 0; i < kps.size(); ++i) kps[i].response = static_cast<float>(i) * 0.37f + 0.11f;
+  const SscResult a = ssc_select(kps, 500, size);
+  const SscResult b = ssc_select(kps, 500, size);
+  EXPECT_EQ(a.kept, b.kept);
+  EXPECT_EQ(a.width, b.width);
+  std::vector<int> perm(kps.size());
+  for (std::size_t i = 0; i < perm.size(); ++i) perm[i] = static_cast<int>(i);
+  std::shuffle(perm.begin(), perm.end(), std::mt19937(9));
+  std::vector<cv::KeyPoint> shuffled;
+  for (int i : perm) shuffled.push_back(kps[static_cast<std::size_t>(i)]);
+  const SscResult c = ssc_select(shuffled, 500, size);
+  std::vector<int> mapped;
+  for (int i : c.kept) mapped.push_back(perm[static_cast<std::size_t>(i)]);
+  EXPECT_EQ(mapped, a.kept);
+}
+
+TEST(Ssc, WidthHintShortensTheSearchAndKeepsTheGuarantees) {
+  const cv::Size size(752, 480);
+  const auto kps = random_keypoints(12000, size, 21u);
+  const SscResult plain = ssc_select(kps, 400, size);
+  ASSERT_GT(plain.iterations, 2);
+  const SscResult hinted = ssc_select(kps, 400, size, 0.001, plain.width);
+  EXPECT_LE(hinted.iterations, 2);
+  EXPECT_EQ(hinted.width, plain.width);
+  EXPECT_EQ(hinted.kept, plain.kept);
+  // A bad hint costs passes but not correctness.
+  for (const double bad : {2.0, 500.0, plain.width + 7}) {
+    const SscResult r = ssc_select(kps, 400, size, 0.001, bad);
+    EXPECT_EQ(r.kept.size(), 400u);
+    EXPECT_GT(min_max_norm_distance(kps, r.kept), r.width);
+  }
+}
+
+TEST(Ssc, FewCandidatesAreAllKept) {
+  const cv::Size size(200, 100);
+  const auto kps = random_keypoints(30, size, 2u);
+  const SscResult r = ssc_select(kps, 50, size);
+  EXPECT_EQ(r.kept.size(), kps.size());
+  EXPECT_TRUE(ssc_select(kps, 0, size).kept.empty());
+  EXPECT_TRUE(ssc_select({}, 10, size).kept.empty());
+}
+
+TEST(Ssc, UpperBoundIsTightForALattice) {
+  // A full lattice of spacing s in a W x H image holds (W/s+1)(H/s+1) points with max-norm
+  // spacing s: for exactly that N the bound must return s.
+  const double W = 300, H = 200, s = 20;
+  const int n = static_cast<int>((W / s + 1) * (H / s + 1));
+  const SscBounds b = ssc_width_bounds(100000, n, cv::Size(300, 200));
+  EXPECT_NEAR(b.high, s, 1e-9);
+  // Lower bound from the covering argument: (sqrt(K/N) - 1) / 2.5.
+  EXPECT_NEAR(ssc_width_bounds(40000, 400, cv::Size(640, 480)).low, (10.0 - 1.0) / 2.5, 1e-12);
+  EXPECT_DOUBLE_EQ(ssc_width_bounds(500, 400, cv::Size(640, 480)).low, 1.0);  // clamped
+}
+
+TEST(Ssc, LowerBoundKeepsEnoughPointsOnDensestInput) {
+  // Every pixel of a 120 x 100 image is a candidate (the densest distinct-integer input); at the
+  // lower-bound width the cover must still keep at least N points.
+  const cv::Size size(120, 100);
+  std::vector<cv::KeyPoint> kps;
+  std::mt19937 rng(4);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x)
+      kps.emplace_back(cv::Point2f(static_cast<float>(x), static_cast<float>(y)), 7.f, -1.f, static_cast<float>(rng() % 200));
+  const int target = 60;
+  const SscBounds b = ssc_width_bounds(static_cast<int>(kps.size()), target, size);
+  ASSERT_GT(b.low, 1.0);
+  const SscResult r = ssc_select(kps, target, size);
+  EXPECT_EQ(static_cast<int>(r.kept.size()), target);
+  EXPECT_GE(r.width, std::floor(b.low));
+}
+
+TEST(Ssc, OrderByResponseIsStableDescending) {
+  std::vector<cv::KeyPoint> kps;
+  for (float r : {3.f, 9.f, 3.f, 250.f, 0.f, 9.f}) kps.emplace_back(cv::Point2f(0, 0), 1.f, -1.f, r);
+  EXPECT_EQ(order_by_response(kps), (std::vector<int>{3, 1, 5, 0, 2, 4}));
+  kps[0].response = 3.5f;  // not an integer: the comparison sort must agree
+  EXPECT_EQ(order_by_response(kps), (std::vector<int>{3, 1, 5, 0, 2, 4}));
+}
+
+TEST(Uniformity, GridCountCv) {
+  std::vector<cv::KeyPoint> even, one_cell;
+  for (int y = 0; y < 12; ++y)
+    for (int x = 0; x < 16; ++x) {
+      even.emplace_back(cv::Point2f(x * 40.f + 5.f, y * 40.f + 5.f), 1.f);
+      one_cell.emplace_back(cv::Point2f(1.f, 1.f), 1.f);
+    }
+  EXPECT_DOUBLE_EQ(grid_count_cv(even, cv::Size(640, 480)), 0.0);
+  // All 192 in one of 192 cells: mean 1, std sqrt(191).
+  EXPECT_NEAR(grid_count_cv(one_cell, cv::Size(640, 480)), std::sqrt(191.0), 1e-9);
+}
+
+}  // namespace
+}  // namespace plslam::features
