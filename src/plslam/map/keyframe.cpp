@@ -28,8 +28,8 @@ Eigen::Vector3d KeyFrame::camera_center() const {
 
 void KeyFrame::set_pose(const geometry::SE3& T_cw) {
   std::lock_guard lock(pose_mutex_);
-  T_cw_ = T_cw;
-  T_wc_ = T_cw.inverse();
+  T_cw_ = T_cw.normalized();
+  T_wc_ = T_cw_.inverse();
 }
 
 void KeyFrame::add_map_point(MapPoint* p, int index) {

@@ -49,6 +49,7 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
   kf.get("pid_output_limit", k.pid_output_limit);
   kf.get("kalman", k.kalman);
   kf.get("max_speed", k.max_speed);
+  kf.get("velocity_min_frames", k.velocity_min_frames);
   k.validate(config.source());
 
   const auto optim = config.section("optim");

@@ -6,7 +6,8 @@
 //   lines:    {enabled, max_lines}
 //   tracking: {init_min_points, close_depth_baselines, motion_radius, local_map_radius,
 //              line_radius, min_local_inliers}
-//   keyframe: {ratio, max_frames, pid, pid_kp, pid_ki, pid_kd, pid_output_limit, kalman, max_speed}
+//   keyframe: {ratio, max_frames, pid, pid_kp, pid_ki, pid_kd, pid_output_limit, kalman, max_speed,
+//              velocity_min_frames}
 //   optim:    {line_information}
 //   mapping:  {local_ba, ba_iterations, culling_redundancy}
 #include <filesystem>

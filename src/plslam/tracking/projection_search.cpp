@@ -46,16 +46,22 @@ int search_points_from_frame(Frame& cur, const Frame& last, double radius, const
     const cv::Mat desc = mp->descriptor();
     if (desc.empty()) continue;
     const double u_right = uv.x() - cam.bf() / Xc.z();
-    int best = std::numeric_limits<int>::max(), best_j = -1;
+    int best = std::numeric_limits<int>::max(), second = best, best_j = -1;
     for (int j : candidates) {
       if (slot_taken(cur, j) || !stereo_consistent(d, j, u_right, r)) continue;
       const int dist = map::descriptor_distance(desc, d.descriptors.row(j));
       if (dist < best) {
+        second = best;
         best = dist;
         best_j = j;
+      } else if (dist < second) {
+        second = dist;
       }
     }
-    if (best_j >= 0 && best <= o.point_max_hamming) {
+    // Low-threshold FAST packs many similar corners into a window: without the ratio test the
+    // nearest look-alike of the predicted position wins, which drags the pose towards the motion
+    // model's prediction and makes the velocity run away.
+    if (best_j >= 0 && best <= o.point_max_hamming && best < o.point_ratio * second) {
       cur.points[static_cast<std::size_t>(best_j)] = mp;
       cur.point_outlier[static_cast<std::size_t>(best_j)] = false;
       ++matches;

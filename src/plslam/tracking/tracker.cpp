@@ -64,7 +64,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     if (state_ == TrackingState::kLost && last_) {
       // A new map segment starts where the motion model puts the camera, so the trajectory stays
       // continuous across the loss.
-      f.T_cw = velocity_ ? *velocity_ * last_->T_cw : last_->T_cw;
+      f.T_cw = velocity_ ? (*velocity_ * last_->T_cw).normalized() : last_->T_cw;
     }
     ok = initialize(f);
     if (ok) {
@@ -80,7 +80,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     }
     if (tracked) {
       ok = true;
-      velocity_ = f.T_cw * last_->T_cw.inverse();
+      velocity_ = (f.T_cw * last_->T_cw.inverse()).normalized();
       const auto inputs = keyframe_inputs(f, result.point_inliers, result.line_inliers);
       result.decision = policy_.decide(inputs);
       if (result.decision.insert) {
@@ -94,7 +94,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       spdlog::warn("frame {}: tracking lost (event {}), starting a new map segment", f.id(), lost_events_);
       state_ = TrackingState::kLost;
       // Keep a pose for the trajectory: the motion model's prediction.
-      f.T_cw = velocity_ && last_ ? *velocity_ * last_->T_cw : (last_ ? last_->T_cw : f.T_cw);
+      f.T_cw = velocity_ && last_ ? (*velocity_ * last_->T_cw).normalized() : (last_ ? last_->T_cw : f.T_cw);
       std::fill(f.points.begin(), f.points.end(), nullptr);
       std::fill(f.lines.begin(), f.lines.end(), nullptr);
     }
@@ -196,7 +196,7 @@ int Tracker::optimize_pose(Frame& f, TrackStageTimes& t) {
   auto popts = options_.pose;
   popts.scale_factor = d.scale_factor;
   const auto r = optim::optimize_pose(cam, f.T_cw, pts, lns, popts);
-  f.T_cw = r.T_cw;
+  f.T_cw = r.T_cw.normalized();
   for (std::size_t k = 0; k < pidx.size(); ++k) f.point_outlier[pidx[k]] = r.point_outlier[k];
   for (std::size_t k = 0; k < lidx.size(); ++k) f.line_outlier[lidx[k]] = r.line_outlier[k];
   t.pose_optimization_ms += ms_since(t0);
@@ -205,7 +205,7 @@ int Tracker::optimize_pose(Frame& f, TrackStageTimes& t) {
 
 bool Tracker::track_with_motion_model(Frame& f, TrackStageTimes& t) {
   const auto t0 = Clock::now();
-  f.T_cw = *velocity_ * last_->T_cw;
+  f.T_cw = (*velocity_ * last_->T_cw).normalized();
   int n = search_points_from_frame(f, *last_, options_.motion_radius, options_.search);
   if (n < options_.min_motion_matches) {
     std::fill(f.points.begin(), f.points.end(), nullptr);
