@@ -25,7 +25,7 @@ std::shared_ptr<FrameData> make_data(long id, int n_points, int n_lines = 0) {
   rng.fill(d->descriptors, cv::RNG::UNIFORM, 0, 256);
   d->lines.resize(static_cast<std::size_t>(n_lines));
   d->line_descriptors = cv::Mat(n_lines, 32, CV_8U);
-  rng.fill(d->line_descriptors, cv::RNG::UNIFORM, 0, 256);
+  if (n_lines > 0) rng.fill(d->line_descriptors, cv::RNG::UNIFORM, 0, 256);
   d->build_grid();
   return d;
 }
@@ -130,14 +130,15 @@ TEST(Map, PointWithOneObservationLeftBecomesBad) {
 }
 
 TEST(Map, MostDistinctiveDescriptorHasSmallestMedianDistance) {
-  cv::Mat base(1, 32, CV_8U, cv::Scalar(0));
-  std::vector<cv::Mat> d;
-  for (int flips : {0, 2, 4, 40}) {
-    cv::Mat m = base.clone();
-    for (int b = 0; b < flips; ++b) m.at<uchar>(0, b / 8) |= static_cast<uchar>(1 << (b % 8));
-    d.push_back(m);
-  }
-  // Distances from the 2-bit one: 2, 2, 38 -> median 2, the smallest.
+  // A central descriptor, three that each differ from it in 4 other bits, and a far one.
+  auto with_bits = [](int from, int to) {
+    cv::Mat m(1, 32, CV_8U, cv::Scalar(0));
+    for (int b = from; b < to; ++b) m.at<uchar>(0, b / 8) |= static_cast<uchar>(1 << (b % 8));
+    return m;
+  };
+  const std::vector<cv::Mat> d{with_bits(0, 4), with_bits(0, 0), with_bits(4, 8), with_bits(8, 12),
+                               with_bits(100, 160)};
+  // Median distances (self included, as ORB-SLAM2): central 4, the others 8, the far one 60+.
   EXPECT_EQ(descriptor_distance(most_distinctive(d), d[1]), 0);
   EXPECT_TRUE(most_distinctive({}).empty());
 }
