@@ -16,3 +16,5 @@ if [ ! -f "$DATA/mav0/synth/synth.json" ]; then  # synth.json is written last: c
   "$BUILD_DIR/plslam" synth --out "$DATA" --scene office --preset euroc --frames 480 --loop --seed 1
 fi
 "$BUILD_DIR/plslam" info "$DATA"
+# Stereo point-line SLAM on it: trajectory, map and statistics in build/demo_run, ATE/RPE at the end.
+"$BUILD_DIR/plslam" run "$DATA" --out "$BUILD_DIR/demo_run"

@@ -8,7 +8,10 @@
 #include "command_registry.h"
 #include "commands/dataset_options.h"
 #include "plslam/core/error.h"
+#include "plslam/features/line_benchmark.h"
 #include "plslam/features/point_benchmark.h"
+#include "plslam/io/frame_stream.h"
+#include "plslam/tracking/frame_extractor.h"
 
 namespace plslam::cli {
 namespace {
@@ -28,6 +31,22 @@ std::string stage_line(const nlohmann::json& j, const char* key, const char* lab
                      s.at("p90").get<double>());
 }
 
+// The whole stereo frame as the tracker gets it: four extraction tasks (left/right x
+// points/lines) then two stereo matching tasks, wall clock with the machine's threads.
+nlohmann::json frame_benchmark(const io::Dataset& ds, bool kitti) {
+  tracking::FrameExtractor extractor(ds.calibration(), kitti ? tracking::FrameExtractorOptions::kitti()
+                                                             : tracking::FrameExtractorOptions::euroc());
+  std::vector<double> ms;
+  io::FrameStream stream(ds);
+  long id = 0;
+  while (auto f = stream.next()) {
+    tracking::FrameTimings t;
+    extractor.extract(id++, f->timestamp, f->left, f->right, &t);
+    ms.push_back(t.total_ms);
+  }
+  return features::summarize(ms);
+}
+
 int run_bench_features(const BenchFeaturesArgs& args) {
   const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
   if (ds->size() == 0) throw InputError(args.dataset.path, "no frames selected");
@@ -37,7 +56,13 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   o.orb.fast_threshold = args.fast_threshold;
   o.right_feature_factor = args.right_factor;
   if (!(o.right_feature_factor >= 1.0)) throw InputError("", "--right-factor must be >= 1");
-  const nlohmann::json j = features::run_point_benchmark(*ds, o);
+  nlohmann::json j = features::run_point_benchmark(*ds, o);
+  // Lines: the same frames, one thread, with OpenCV LSD + LBD timed as the reference.
+  const bool kitti = ds->format() == io::DatasetFormat::kKitti;
+  features::LineBenchmarkOptions lo;
+  lo.extractor = kitti ? features::LineExtractorOptions::kitti() : features::LineExtractorOptions::euroc();
+  j.update(features::benchmark_lines(*ds, 0, lo));
+  j["frame_ms"] = frame_benchmark(*ds, kitti);
   if (args.json) {
     std::cout << j.dump(2) << "\n";
     return 0;
@@ -58,14 +83,24 @@ int run_bench_features(const BenchFeaturesArgs& args) {
                            100.0 * j["stereo_matches"]["share"]["median"].get<double>())
             << fmt::format("  uniformity CV (16x12 grid, lower is better)  SSC {:.3f}  quadtree {:.3f}\n",
                            j["uniformity_cv"]["ssc"]["median"].get<double>(),
-                           j["uniformity_cv"]["quadtree"]["median"].get<double>());
+                           j["uniformity_cv"]["quadtree"]["median"].get<double>())
+            << "lines, left image (one thread):\n"
+            << stage_line(j, "lsd_ms", "OpenCV LSD") << stage_line(j, "fast_lines_ms", "fast detector")
+            << stage_line(j, "merge_ms", "merge + keep N") << stage_line(j, "lbd_ms", "LBD")
+            << stage_line(j, "lines_image_ms", "lines total") << stage_line(j, "stereo_lines_ms", "stereo matching")
+            << fmt::format("  lines detected {:.0f}, after merge {:.0f}, stereo matches {:.0f}; {:.1f}x faster than "
+                           "OpenCV LSD+LBD\n",
+                           j["lines_detected"]["median"].get<double>(), j["lines_after_merge"]["median"].get<double>(),
+                           j["stereo_line_matches"]["median"].get<double>(), j["lines_speedup_vs_opencv"].get<double>())
+            << "whole stereo frame (points and lines, parallel):\n"
+            << stage_line(j, "frame_ms", "frame");
   return 0;
 }
 
 CommandRegistration reg({"bench", "Benchmark front-end stages on real frames", [](CLI::App& sub) {
                            sub.require_subcommand(1);
                            auto args = std::make_shared<BenchFeaturesArgs>();
-                           CLI::App* features = sub.add_subcommand("features", "Point features: per-stage ms, counts, uniformity");
+                           CLI::App* features = sub.add_subcommand("features", "Point and line features: per-stage ms, counts, uniformity, whole-frame ms");
                            features->add_option("dataset", args->dataset.path, "KITTI sequences/NN or EuRoC <seq>[/mav0]")->required();
                            features->add_option("--format", args->dataset.format, "Dataset format")
                                ->check(CLI::IsMember({"auto", "kitti", "euroc"}))

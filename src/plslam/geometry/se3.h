@@ -45,6 +45,10 @@ class SE3 {
   const Eigen::Matrix3d& rotation() const { return R_; }
   const Eigen::Vector3d& translation() const { return t_; }
   Eigen::Quaterniond quaternion() const { return Eigen::Quaterniond(R_).normalized(); }
+  // The same pose with its rotation projected back onto SO(3). Products of rotations drift off
+  // SO(3) by rounding; where poses are composed over and over (a constant-velocity model feeds its
+  // own output back), that drift grows geometrically and must be removed.
+  SE3 normalized() const { return SE3(quaternion(), t_); }
   Eigen::Matrix4d matrix() const;
   Eigen::Isometry3d isometry() const;
 

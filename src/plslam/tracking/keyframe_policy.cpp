@@ -17,6 +17,7 @@ void KeyframePolicyOptions::validate(const std::string& source) const {
   if (pid_integral_limit < 0) fail("pid_integral_limit", "must be >= 0");
   if (!(pid_output_limit >= 0 && pid_output_limit < 1)) fail("pid_output_limit", "must be in [0, 1)");
   if (!(max_speed > 0)) fail("max_speed", "must be positive");
+  if (velocity_min_frames < 1) fail("velocity_min_frames", "must be >= 1");
   if (!(kalman_options.accel_noise > 0)) fail("kalman_accel_noise", "must be positive");
   if (!(kalman_options.position_noise > 0)) fail("kalman_position_noise", "must be positive");
 }
@@ -77,7 +78,7 @@ KeyframeDecision KeyframePolicy::decide(const KeyframeInputs& in) {
     d.insert = true;
     d.reason = weak ? KeyframeReason::kInlierRatio : KeyframeReason::kCloseDepth;
     if (c1a && !c1b && !c1c) d.reason = KeyframeReason::kMaxFrames;
-  } else if (options_.kalman && d.speed > options_.max_speed && since >= 1 &&
+  } else if (options_.kalman && d.speed > options_.max_speed && since >= options_.velocity_min_frames &&
              in.tracked_inliers > options_.min_inliers) {
     d.insert = true;
     d.reason = KeyframeReason::kVelocity;

@@ -36,6 +36,9 @@ struct KeyframePolicyOptions {
 
   bool kalman = true;
   double max_speed = 7.0;  // m/s
+  // The velocity rule fires at most every this many frames: a car at 11 m/s is above 7 m/s all the
+  // time, and a keyframe on every frame would only repeat the same close points.
+  int velocity_min_frames = 2;
   VelocityKalmanOptions kalman_options;
 
   // Throws InputError naming `source` and the offending option when out of range.

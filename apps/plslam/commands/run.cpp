@@ -1,0 +1,133 @@
+// plslam run <dataset> --out DIR: stereo point-line SLAM over a sequence, with progress output,
+// trajectory/map/statistics files, and ATE/RPE against the ground truth when there is one.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <iostream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
+#include "command_registry.h"
+#include "commands/dataset_options.h"
+#include "plslam/core/error.h"
+#include "plslam/io/frame_stream.h"
+#include "plslam/io/map_export.h"
+#include "plslam/io/trajectory_io.h"
+#include "plslam/system/run_report.h"
+#include "plslam/system/slam_system.h"
+#include "plslam/system/system_config.h"
+
+namespace plslam::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_sigint(int) { g_interrupted = true; }
+
+struct RunArgs {
+  DatasetArgs dataset;
+  std::string out;
+  std::string config;
+  bool no_lines = false;
+  bool quiet = false;
+  bool realtime = false;
+  bool sequential = false;
+};
+
+int run_slam(const RunArgs& args) {
+  const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
+  auto options = system::load_system_options(
+      ds->format(), args.config.empty() ? std::nullopt : std::optional<fs::path>(args.config));
+  if (args.no_lines) options.disable_lines();
+  options.sequential = args.sequential;
+  const fs::path out_dir = args.out;
+  fs::create_directories(out_dir);
+
+  spdlog::info("{}: {} frames, {}x{}, {:.1f} fps, baseline {:.3f} m, lines {}", ds->root().string(), ds->size(),
+               ds->calibration().width, ds->calibration().height, ds->fps(), ds->calibration().baseline,
+               options.extractor.lines ? "on" : "off");
+
+  system::System slam(ds->calibration(), options);
+  system::RunReport report;
+  std::signal(SIGINT, on_sigint);
+  std::string fatal;
+  const auto start = std::chrono::steady_clock::now();
+  auto last_progress = start;
+  try {
+    io::FrameStream stream(*ds);
+    std::size_t done = 0;
+    while (!g_interrupted) {
+      auto frame = stream.next();
+      if (!frame) break;
+      if (args.realtime && done > 0) {
+        // Pace the input at the dataset's rate, as a live camera would deliver it.
+        const double t_rel = frame->timestamp - ds->timestamps().front();
+        std::this_thread::sleep_until(start + std::chrono::duration<double>(t_rel));
+      }
+      const auto r = slam.process(*frame);
+      report.add(r);
+      ++done;
+      const auto now = std::chrono::steady_clock::now();
+      if (!args.quiet && (now - last_progress > std::chrono::seconds(1) || done == ds->size())) {
+        last_progress = now;
+        const double elapsed = std::chrono::duration<double>(now - start).count();
+        spdlog::info("frame {}/{}  {:.1f} fps  {}  KF {}  MP {}  ML {}", done, ds->size(), done / elapsed,
+                     tracking::to_string(r.track.state), slam.map().num_keyframes(), slam.map().num_points(),
+                     slam.map().num_lines());
+      }
+    }
+    report.skipped_frames = stream.skipped();
+  } catch (const InputError& e) {
+    fatal = e.what();  // outputs so far are still written below
+  }
+  if (g_interrupted) spdlog::warn("interrupted: writing the outputs gathered so far");
+  slam.finish();
+
+  const auto traj = slam.trajectory();
+  io::write_trajectory(out_dir / "trajectory.tum", traj, io::TrajectoryFormat::kTum);
+  if (ds->format() == io::DatasetFormat::kKitti) {
+    io::write_trajectory(out_dir / "trajectory.kitti", traj, io::TrajectoryFormat::kKitti);
+  }
+  io::write_trajectory(out_dir / "keyframes.tum", slam.keyframe_trajectory(), io::TrajectoryFormat::kTum);
+  std::vector<Eigen::Vector3d> points;
+  for (const auto* p : slam.map().points()) points.push_back(p->position());
+  io::write_ply_points(out_dir / "map_points.ply", points);
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> lines;
+  for (const auto* l : slam.map().lines()) lines.emplace_back(l->start(), l->end());
+  io::write_ply_lines(out_dir / "map_lines.ply", lines);
+
+  auto stats = report.to_json(slam);
+  if (ds->ground_truth()) {
+    const auto accuracy = system::evaluate_against_ground_truth(*ds, traj);
+    stats["accuracy"] = accuracy;
+    std::cout << system::format_accuracy(accuracy);
+  }
+  std::ofstream(out_dir / "stats.json") << stats.dump(2) << "\n";
+  std::cout << report.summary(slam);
+  spdlog::info("outputs written to {}", out_dir.string());
+  if (!fatal.empty()) throw InputError("", fatal);
+  return g_interrupted ? 130 : 0;
+}
+
+CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](CLI::App& sub) {
+                           auto args = std::make_shared<RunArgs>();
+                           add_dataset_options(sub, args->dataset);
+                           sub.add_option("--out", args->out, "Output folder")->required();
+                           sub.add_option("--config", args->config,
+                                          "YAML configuration (default: the preset for the dataset format)");
+                           sub.add_flag("--no-lines", args->no_lines, "Points only");
+                           sub.add_flag("--quiet", args->quiet, "No progress lines");
+                           sub.add_flag("--realtime", args->realtime, "Pace the input at the dataset's frame rate");
+                           sub.add_flag("--sequential", args->sequential,
+                                        "Run local mapping in the tracking thread (reproducible runs)");
+                           return std::function<int()>([args] { return run_slam(*args); });
+                         }});
+
+}  // namespace
+}  // namespace plslam::cli

@@ -1,0 +1,16 @@
+#pragma once
+// Descriptor helpers shared by points and lines (both 256-bit binary descriptors).
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace plslam::map {
+
+// Hamming distance of two 1x32 CV_8U rows.
+int descriptor_distance(const cv::Mat& a, const cv::Mat& b);
+
+// The descriptor with the smallest median distance to all others (ORB-SLAM2's choice of a
+// landmark's representative descriptor). Empty input gives an empty Mat.
+cv::Mat most_distinctive(const std::vector<cv::Mat>& descriptors);
+
+}  // namespace plslam::map

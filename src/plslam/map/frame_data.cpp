@@ -1,0 +1,46 @@
+#include "plslam/map/frame_data.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace plslam::map {
+
+void FrameData::build_grid() {
+  grid.assign(static_cast<std::size_t>(kGridCols * kGridRows), {});
+  const double cw = static_cast<double>(calib.width) / kGridCols;
+  const double ch = static_cast<double>(calib.height) / kGridRows;
+  for (std::size_t i = 0; i < keypoints.size(); ++i) {
+    const int cx = std::clamp(static_cast<int>(keypoints[i].pt.x / cw), 0, kGridCols - 1);
+    const int cy = std::clamp(static_cast<int>(keypoints[i].pt.y / ch), 0, kGridRows - 1);
+    grid[static_cast<std::size_t>(cy * kGridCols + cx)].push_back(static_cast<int>(i));
+  }
+}
+
+std::vector<int> FrameData::points_in_area(double u, double v, double r, int min_level, int max_level) const {
+  std::vector<int> out;
+  if (grid.empty()) return out;
+  const double cw = static_cast<double>(calib.width) / kGridCols;
+  const double ch = static_cast<double>(calib.height) / kGridRows;
+  const int x0 = std::max(0, static_cast<int>(std::floor((u - r) / cw)));
+  const int x1 = std::min(kGridCols - 1, static_cast<int>(std::floor((u + r) / cw)));
+  const int y0 = std::max(0, static_cast<int>(std::floor((v - r) / ch)));
+  const int y1 = std::min(kGridRows - 1, static_cast<int>(std::floor((v + r) / ch)));
+  if (x0 > x1 || y0 > y1) return out;
+  const double r2 = r * r;
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      for (int i : grid[static_cast<std::size_t>(y * kGridCols + x)]) {
+        const auto& kp = keypoints[static_cast<std::size_t>(i)];
+        if (kp.octave < min_level || (max_level >= 0 && kp.octave > max_level)) continue;
+        const double dx = kp.pt.x - u, dy = kp.pt.y - v;
+        if (dx * dx + dy * dy <= r2) out.push_back(i);
+      }
+    }
+  }
+  return out;
+}
+
+double FrameData::level_scale(int level) const { return std::pow(scale_factor, level); }
+double FrameData::level_sigma2(int level) const { return std::pow(scale_factor, 2 * level); }
+
+}  // namespace plslam::map

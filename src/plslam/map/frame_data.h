@@ -1,0 +1,57 @@
+#pragma once
+// Everything extracted from one rectified stereo pair, immutable once built: stereo keypoints,
+// stereo line segments, and a grid over the left image for fast projection search. Frames and the
+// keyframes made from them share one FrameData.
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "plslam/core/types.h"
+#include "plslam/features/line_segment.h"
+
+namespace plslam::map {
+
+struct LineObservation {
+  features::LineSegment segment;  // left image, level-0 pixels
+  // Image lines a u + b v + c = 0 with a^2 + b^2 = 1: through the left segment, and through the
+  // matched right segment when `stereo`.
+  Eigen::Vector3d left_line = Eigen::Vector3d::Zero();
+  Eigen::Vector3d right_line = Eigen::Vector3d::Zero();
+  bool stereo = false;
+  Eigen::Vector3d start_cam = Eigen::Vector3d::Zero();  // 3D endpoints in the left camera (stereo only)
+  Eigen::Vector3d end_cam = Eigen::Vector3d::Zero();
+};
+
+struct FrameData {
+  long frame_id = 0;
+  double timestamp = 0;
+  StereoCalibration calib;
+  int levels = 8;
+  double scale_factor = 1.2;
+
+  std::vector<cv::KeyPoint> keypoints;  // left image, level-0 pixels, octave = level
+  cv::Mat descriptors;                  // N x 32 CV_8U
+  std::vector<float> u_right;           // -1 when no stereo match
+  std::vector<float> depth;             // metres, -1 when no stereo match
+
+  std::vector<LineObservation> lines;
+  cv::Mat line_descriptors;  // M x 32 CV_8U (LBD)
+
+  // Grid of keypoint indices over the left image, built by build_grid().
+  static constexpr int kGridCols = 64, kGridRows = 48;
+  std::vector<std::vector<int>> grid;
+
+  void build_grid();
+  // Indices of keypoints within radius r of (u, v) whose level lies in [min_level, max_level]
+  // (max_level < 0: no upper bound).
+  std::vector<int> points_in_area(double u, double v, double r, int min_level = 0, int max_level = -1) const;
+
+  double level_scale(int level) const;        // scale_factor^level
+  double level_sigma2(int level) const;       // scale_factor^(2 level)
+  std::size_t num_points() const { return keypoints.size(); }
+  std::size_t num_lines() const { return lines.size(); }
+};
+
+}  // namespace plslam::map

@@ -1,0 +1,101 @@
+#pragma once
+// A keyframe: a frame kept in the map, with its pose, its associations to map points and lines,
+// its covisibility edges (weighted by shared points and lines) and its place in the spanning tree.
+// Owned by the Map; other objects hold non-owning pointers. Pose, associations and graph edges
+// each have their own mutex because tracking, local mapping and (later) loop closing use them
+// concurrently.
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <vector>
+
+#include "plslam/geometry/se3.h"
+#include "plslam/map/frame_data.h"
+
+namespace plslam::map {
+
+class MapPoint;
+class MapLine;
+
+class KeyFrame {
+ public:
+  KeyFrame(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw);
+
+  long id() const { return id_; }
+  const FrameData& data() const { return *data_; }
+  long frame_id() const { return data_->frame_id; }
+  double timestamp() const { return data_->timestamp; }
+
+  geometry::SE3 pose() const;  // T_cw
+  geometry::SE3 pose_inverse() const;  // T_wc
+  Eigen::Vector3d camera_center() const;
+  void set_pose(const geometry::SE3& T_cw);
+
+  // Point associations, indexed like data().keypoints.
+  void add_map_point(MapPoint* p, int index);
+  void erase_map_point(int index);
+  void erase_map_point(const MapPoint* p);
+  MapPoint* map_point(int index) const;
+  std::vector<MapPoint*> map_points() const;  // same size as keypoints; nullptr where none
+  // Map points observed by at least min_obs keyframes (ORB-SLAM2's TrackedMapPoints).
+  int tracked_map_points(int min_obs) const;
+
+  // Line associations, indexed like data().lines.
+  void add_map_line(MapLine* l, int index);
+  void erase_map_line(int index);
+  void erase_map_line(const MapLine* l);
+  MapLine* map_line(int index) const;
+  std::vector<MapLine*> map_lines() const;
+  int tracked_map_lines(int min_obs) const;
+
+  // Covisibility: recomputes the weights to every keyframe sharing at least `min_shared` points
+  // or lines (the strongest one is kept even below it), updates the other side's edges, and on
+  // first call attaches this keyframe to the spanning tree under its strongest neighbour.
+  void update_connections(int min_shared = 15);
+  void add_connection(KeyFrame* kf, int weight);
+  void erase_connection(KeyFrame* kf);
+  std::vector<KeyFrame*> covisibles() const;                 // by decreasing weight
+  std::vector<KeyFrame*> best_covisibles(std::size_t n) const;
+  int weight(const KeyFrame* kf) const;
+
+  // Spanning tree.
+  KeyFrame* parent() const;
+  std::set<KeyFrame*> children() const;
+  void add_child(KeyFrame* kf);
+  void erase_child(KeyFrame* kf);
+  void change_parent(KeyFrame* kf);
+
+  // Never removes the first keyframe. Otherwise: detaches from points, lines and the graph,
+  // re-parents its children to their best covisible candidate, and remembers its pose relative
+  // to its parent so that frames that referenced it keep a valid pose.
+  void set_bad();
+  bool is_bad() const;
+  // For a bad keyframe: T_cp, its pose relative to its parent at the time it was culled.
+  geometry::SE3 pose_relative_to_parent() const;
+
+ private:
+  const long id_;
+  const std::shared_ptr<const FrameData> data_;
+
+  mutable std::mutex pose_mutex_;
+  geometry::SE3 T_cw_;
+  geometry::SE3 T_wc_;
+
+  mutable std::mutex features_mutex_;
+  std::vector<MapPoint*> points_;
+  std::vector<MapLine*> lines_;
+
+  mutable std::mutex graph_mutex_;
+  std::map<KeyFrame*, int> weights_;
+  std::vector<KeyFrame*> ordered_;  // covisibles by decreasing weight
+  KeyFrame* parent_ = nullptr;
+  std::set<KeyFrame*> children_;
+  bool first_connection_ = true;
+  bool bad_ = false;
+  geometry::SE3 T_cp_;
+
+  void sort_connections_locked();
+};
+
+}  // namespace plslam::map

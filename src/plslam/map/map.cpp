@@ -1,0 +1,86 @@
+#include "plslam/map/map.h"
+
+namespace plslam::map {
+
+KeyFrame* Map::create_keyframe(std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw) {
+  std::lock_guard lock(mutex_);
+  all_keyframes_.push_back(std::make_unique<KeyFrame>(next_keyframe_id_++, std::move(data), T_cw));
+  keyframes_.insert(all_keyframes_.back().get());
+  return all_keyframes_.back().get();
+}
+
+MapPoint* Map::create_point(const Eigen::Vector3d& position, KeyFrame* reference, long frame_id) {
+  std::lock_guard lock(mutex_);
+  all_points_.push_back(std::make_unique<MapPoint>(next_point_id_++, position, reference, frame_id));
+  points_.insert(all_points_.back().get());
+  return all_points_.back().get();
+}
+
+MapLine* Map::create_line(const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
+                          long frame_id) {
+  std::lock_guard lock(mutex_);
+  all_lines_.push_back(std::make_unique<MapLine>(next_line_id_++, start, end, reference, frame_id));
+  lines_.insert(all_lines_.back().get());
+  return all_lines_.back().get();
+}
+
+void Map::erase_keyframe(KeyFrame* kf) {
+  std::lock_guard lock(mutex_);
+  keyframes_.erase(kf);
+}
+
+void Map::erase_point(MapPoint* p) {
+  std::lock_guard lock(mutex_);
+  points_.erase(p);
+}
+
+void Map::erase_line(MapLine* l) {
+  std::lock_guard lock(mutex_);
+  lines_.erase(l);
+}
+
+namespace {
+
+// Objects can turn bad from other threads (e.g. a point losing its last observations); the
+// active sets drop them lazily here.
+template <class Set>
+std::vector<typename Set::key_type> active(Set& set) {
+  std::vector<typename Set::key_type> out;
+  out.reserve(set.size());
+  for (auto it = set.begin(); it != set.end();) {
+    if ((*it)->is_bad()) {
+      it = set.erase(it);
+    } else {
+      out.push_back(*it++);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<KeyFrame*> Map::keyframes() const {
+  std::lock_guard lock(mutex_);
+  return active(keyframes_);
+}
+
+std::vector<MapPoint*> Map::points() const {
+  std::lock_guard lock(mutex_);
+  return active(points_);
+}
+
+std::vector<MapLine*> Map::lines() const {
+  std::lock_guard lock(mutex_);
+  return active(lines_);
+}
+
+std::size_t Map::num_keyframes() const { return keyframes().size(); }
+std::size_t Map::num_points() const { return points().size(); }
+std::size_t Map::num_lines() const { return lines().size(); }
+
+KeyFrame* Map::first_keyframe() const {
+  std::lock_guard lock(mutex_);
+  return all_keyframes_.empty() ? nullptr : all_keyframes_.front().get();
+}
+
+}  // namespace plslam::map

@@ -1,0 +1,60 @@
+#pragma once
+// The map: owner of every keyframe, map point and map line. Objects are never freed before the
+// Map itself, so the raw pointers that frames, keyframes and landmarks keep to each other stay
+// valid; culled objects are flagged bad and leave the active sets. Thread-safe.
+#include <memory>
+#include <mutex>
+#include <set>
+#include <vector>
+
+#include "plslam/map/keyframe.h"
+#include "plslam/map/map_line.h"
+#include "plslam/map/map_point.h"
+
+namespace plslam::map {
+
+class Map {
+ public:
+  Map() = default;
+  Map(const Map&) = delete;
+  Map& operator=(const Map&) = delete;
+
+  KeyFrame* create_keyframe(std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw);
+  MapPoint* create_point(const Eigen::Vector3d& position, KeyFrame* reference, long frame_id);
+  MapLine* create_line(const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
+                       long frame_id);
+
+  // Removes from the active sets (the object stays alive until the Map is destroyed).
+  void erase_keyframe(KeyFrame* kf);
+  void erase_point(MapPoint* p);
+  void erase_line(MapLine* l);
+
+  std::vector<KeyFrame*> keyframes() const;  // active, by id
+  std::vector<MapPoint*> points() const;
+  std::vector<MapLine*> lines() const;
+  std::size_t num_keyframes() const;
+  std::size_t num_points() const;
+  std::size_t num_lines() const;
+  KeyFrame* first_keyframe() const;
+
+  // Held by whoever changes poses or structure wholesale (local BA write-back) and by tracking
+  // while it reads them, so that tracking never sees half an update (ORB-SLAM2's mMutexMapUpdate).
+  std::mutex& update_mutex() { return update_mutex_; }
+
+ private:
+  struct ById {
+    template <class T>
+    bool operator()(const T* a, const T* b) const { return a->id() < b->id(); }
+  };
+  mutable std::mutex mutex_;
+  std::mutex update_mutex_;
+  std::vector<std::unique_ptr<KeyFrame>> all_keyframes_;
+  std::vector<std::unique_ptr<MapPoint>> all_points_;
+  std::vector<std::unique_ptr<MapLine>> all_lines_;
+  mutable std::set<KeyFrame*, ById> keyframes_;
+  mutable std::set<MapPoint*, ById> points_;
+  mutable std::set<MapLine*, ById> lines_;
+  long next_keyframe_id_ = 0, next_point_id_ = 0, next_line_id_ = 0;
+};
+
+}  // namespace plslam::map

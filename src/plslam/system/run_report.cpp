@@ -1,0 +1,90 @@
+#include "plslam/system/run_report.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "plslam/eval/evaluate.h"
+
+namespace plslam::system {
+namespace {
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(pos);
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+double mean(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+nlohmann::json timing(const std::vector<double>& v) {
+  return {{"median", percentile(v, 0.5)},
+          {"mean", mean(v)},
+          {"p90", percentile(v, 0.9)},
+          {"max", v.empty() ? 0.0 : *std::max_element(v.begin(), v.end())}};
+}
+
+}  // namespace
+
+void RunReport::add(const FrameResult& r) {
+  ++frames;
+  if (r.track.state == tracking::TrackingState::kOk) ++tracked_frames;
+  tracking_ms.push_back(r.tracking_ms);
+  extraction_ms.push_back(r.extraction.extraction_ms);
+  stereo_ms.push_back(r.extraction.stereo_ms);
+  track_motion_ms.push_back(r.track.times.track_motion_ms);
+  track_local_map_ms.push_back(r.track.times.track_local_map_ms);
+  pose_optimization_ms.push_back(r.track.times.pose_optimization_ms);
+}
+
+nlohmann::json RunReport::to_json(const System& slam) const {
+  const auto ms = slam.mapper_stats();
+  return {{"frames", frames},
+          {"tracked_frames", tracked_frames},
+          {"skipped_frames", skipped_frames},
+          {"lost_events", slam.tracker().lost_events()},
+          {"keyframes", slam.map().num_keyframes()},
+          {"map_points", slam.map().num_points()},
+          {"map_lines", slam.map().num_lines()},
+          {"tracking_ms", timing(tracking_ms)},
+          {"stages_ms",
+           {{"extraction", percentile(extraction_ms, 0.5)},
+            {"stereo_matching", percentile(stereo_ms, 0.5)},
+            {"track_motion", percentile(track_motion_ms, 0.5)},
+            {"track_local_map", percentile(track_local_map_ms, 0.5)},
+            {"pose_optimization", percentile(pose_optimization_ms, 0.5)}}},
+          {"local_ba_ms", {{"median", percentile(ms.local_ba_ms, 0.5)}, {"count", ms.local_ba_ms.size()}}},
+          {"culled_keyframes", ms.culled_keyframes},
+          {"triangulated_points", ms.triangulated_points}};
+}
+
+std::string RunReport::summary(const System& slam) const {
+  return fmt::format(
+      "frames {} (tracked {}), lost events {}, keyframes {}, map points {}, map lines {}\n"
+      "tracking ms/frame: median {:.1f}, mean {:.1f}, p90 {:.1f}\n",
+      frames, tracked_frames, slam.tracker().lost_events(), slam.map().num_keyframes(), slam.map().num_points(),
+      slam.map().num_lines(), percentile(tracking_ms, 0.5), mean(tracking_ms), percentile(tracking_ms, 0.9));
+}
+
+nlohmann::json evaluate_against_ground_truth(const io::Dataset& dataset, const Trajectory& estimate) {
+  eval::EvalOptions o;
+  o.align = eval::AlignMode::kSE3;
+  const auto r = eval::evaluate(*dataset.ground_truth(), estimate, o);
+  auto j = eval::to_json(r);
+  j["ground_truth"] = dataset.ground_truth_path().string();
+  return j;
+}
+
+std::string format_accuracy(const nlohmann::json& a) {
+  return fmt::format("ATE (se3) rmse {:.4f} m over {} poses; RPE (1 frame) rmse {:.4f} m, {:.3f} deg\n",
+                     a["ape_trans_m"]["rmse"].get<double>(), a["pairs"].get<std::size_t>(),
+                     a["rpe_trans_m"]["rmse"].get<double>(), a["rpe_rot_deg"]["rmse"].get<double>());
+}
+
+}  // namespace plslam::system

@@ -1,0 +1,29 @@
+#pragma once
+// What `plslam run` reports: per-frame timings and counts gathered during the run, turned into
+// stats.json and a short summary; and the accuracy against the dataset's ground truth.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "plslam/io/dataset.h"
+#include "plslam/system/slam_system.h"
+
+namespace plslam::system {
+
+struct RunReport {
+  std::vector<double> tracking_ms, extraction_ms, stereo_ms, track_motion_ms, track_local_map_ms,
+      pose_optimization_ms;
+  std::size_t frames = 0, tracked_frames = 0, skipped_frames = 0;
+
+  void add(const FrameResult& r);
+  nlohmann::json to_json(const System& slam) const;
+  std::string summary(const System& slam) const;
+};
+
+// ATE (se3 alignment) and RPE (1 frame) of the trajectory against the dataset's ground truth,
+// through the eval library.
+nlohmann::json evaluate_against_ground_truth(const io::Dataset& dataset, const Trajectory& estimate);
+std::string format_accuracy(const nlohmann::json& accuracy);
+
+}  // namespace plslam::system

@@ -1,0 +1,75 @@
+#include "plslam/system/slam_system.h"
+
+#include <algorithm>
+#include <chrono>
+
+namespace plslam::system {
+
+SystemOptions SystemOptions::euroc() {
+  SystemOptions o;
+  o.extractor = tracking::FrameExtractorOptions::euroc();
+  return o;
+}
+
+SystemOptions SystemOptions::kitti() {
+  SystemOptions o;
+  o.extractor = tracking::FrameExtractorOptions::kitti();
+  // Cars move fast: ORB-SLAM2's KITTI settings keep the same search radii; the keyframe policy's
+  // max_frames follows the 10 Hz rate.
+  o.tracker.keyframe.max_frames = 10;
+  return o;
+}
+
+void SystemOptions::disable_lines() {
+  extractor.lines = false;
+  tracker.lines = false;
+  mapper.lines = false;
+}
+
+System::System(const StereoCalibration& calib, SystemOptions options)
+    : options_(std::move(options)), extractor_(calib, options_.extractor) {
+  options_.mapper.line_information = options_.tracker.line_information;
+  mapper_ = std::make_unique<mapping::LocalMapper>(map_, options_.mapper);
+  auto* mapper = mapper_.get();
+  const bool sequential = options_.sequential;
+  tracker_ = std::make_unique<tracking::Tracker>(
+      map_, options_.tracker, [mapper](map::KeyFrame* kf) { mapper->insert(kf); },
+      [mapper, sequential] { return sequential || mapper->idle(); });
+  if (!sequential) mapper_->start();
+}
+
+System::~System() { finish(); }
+
+FrameResult System::process(const io::StereoFrame& frame) {
+  const auto t0 = std::chrono::steady_clock::now();
+  FrameResult r;
+  auto data = extractor_.extract(next_frame_id_++, frame.timestamp, frame.left, frame.right, &r.extraction);
+  r.track = tracker_->track(std::move(data));
+  r.tracking_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (options_.sequential) mapper_->process_pending();
+  return r;
+}
+
+void System::finish() {
+  if (finished_) return;
+  finished_ = true;
+  mapper_->wait_idle();
+  mapper_->stop();
+}
+
+Trajectory System::trajectory() const {
+  Trajectory out;
+  for (const auto& rec : tracker_->records()) {
+    out.push_back({rec.timestamp, tracking::Tracker::pose_of(rec).inverse().isometry()});
+  }
+  return out;
+}
+
+Trajectory System::keyframe_trajectory() const {
+  Trajectory out;
+  for (auto* kf : map_.keyframes()) out.push_back({kf->timestamp(), kf->pose_inverse().isometry()});
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
+  return out;
+}
+
+}  // namespace plslam::system

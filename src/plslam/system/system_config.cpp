@@ -1,0 +1,73 @@
+#include "plslam/system/system_config.h"
+
+#include <fmt/format.h>
+
+#include "plslam/core/error.h"
+
+namespace plslam::system {
+
+SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
+  const auto features = config.section("features");
+  features.get("n_points", o.extractor.orb.n_features);
+  features.get("levels", o.extractor.orb.levels);
+  features.get("scale_factor", o.extractor.orb.scale_factor);
+  features.get("fast_threshold", o.extractor.orb.fast_threshold);
+  std::string distribution = features::to_string(o.extractor.orb.distribution);
+  features.get("distribution", distribution);
+  try {
+    o.extractor.orb.distribution = features::parse_distribution(distribution);
+    o.extractor.orb.validate();
+  } catch (const InputError& e) {
+    throw InputError(config.source(), std::string("features: ") + e.problem());
+  }
+
+  const auto lines = config.section("lines");
+  bool lines_enabled = o.extractor.lines;
+  lines.get("enabled", lines_enabled);
+  int max_lines = static_cast<int>(o.extractor.line_extractor.max_lines);
+  lines.get("max_lines", max_lines);
+  if (max_lines < 0) throw InputError(config.source(), "lines.max_lines: must be >= 0");
+  o.extractor.line_extractor.max_lines = static_cast<std::size_t>(max_lines);
+  if (!lines_enabled) o.disable_lines();
+
+  const auto tracking = config.section("tracking");
+  tracking.get("init_min_points", o.tracker.init_min_points);
+  tracking.get("close_depth_baselines", o.tracker.close_depth_baselines);
+  tracking.get("motion_radius", o.tracker.motion_radius);
+  tracking.get("local_map_radius", o.tracker.local_map_radius);
+  tracking.get("line_radius", o.tracker.line_radius);
+  tracking.get("min_local_inliers", o.tracker.min_local_inliers);
+
+  const auto kf = config.section("keyframe");
+  auto& k = o.tracker.keyframe;
+  kf.get("ratio", k.ratio);
+  kf.get("max_frames", k.max_frames);
+  kf.get("pid", k.pid);
+  kf.get("pid_kp", k.pid_gains.kp);
+  kf.get("pid_ki", k.pid_gains.ki);
+  kf.get("pid_kd", k.pid_gains.kd);
+  kf.get("pid_output_limit", k.pid_output_limit);
+  kf.get("kalman", k.kalman);
+  kf.get("max_speed", k.max_speed);
+  kf.get("velocity_min_frames", k.velocity_min_frames);
+  k.validate(config.source());
+
+  const auto optim = config.section("optim");
+  optim.get("line_information", o.tracker.line_information);
+  if (!(o.tracker.line_information > 0)) throw InputError(config.source(), "optim.line_information: must be positive");
+
+  const auto mapping = config.section("mapping");
+  mapping.get("local_ba", o.mapper.local_ba);
+  mapping.get("ba_iterations", o.mapper.ba_iterations);
+  mapping.get("culling_redundancy", o.mapper.culling_redundancy);
+
+  config.check_all_used();
+  return o;
+}
+
+SystemOptions load_system_options(io::DatasetFormat format, const std::optional<std::filesystem::path>& file) {
+  const SystemOptions preset = format == io::DatasetFormat::kKitti ? SystemOptions::kitti() : SystemOptions::euroc();
+  return apply_config(file ? ConfigReader::from_file(*file) : ConfigReader(), preset);
+}
+
+}  // namespace plslam::system

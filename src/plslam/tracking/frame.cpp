@@ -1,0 +1,32 @@
+#include "plslam/tracking/frame.h"
+
+namespace plslam::tracking {
+
+int Frame::num_matched_points() const {
+  int n = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) n += points[i] && !point_outlier[i];
+  return n;
+}
+
+int Frame::num_matched_lines() const {
+  int n = 0;
+  for (std::size_t i = 0; i < lines.size(); ++i) n += lines[i] && !line_outlier[i];
+  return n;
+}
+
+void Frame::discard_outliers() {
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (point_outlier[i]) {
+      points[i] = nullptr;
+      point_outlier[i] = false;
+    }
+  }
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (line_outlier[i]) {
+      lines[i] = nullptr;
+      line_outlier[i] = false;
+    }
+  }
+}
+
+}  // namespace plslam::tracking

@@ -1,0 +1,42 @@
+#pragma once
+// The frame being tracked: its extracted features (shared with the keyframe it may become), its
+// pose, and its current associations to map points and map lines.
+#include <memory>
+#include <vector>
+
+#include "plslam/geometry/se3.h"
+#include "plslam/map/frame_data.h"
+
+namespace plslam::map {
+class KeyFrame;
+class MapPoint;
+class MapLine;
+}  // namespace plslam::map
+
+namespace plslam::tracking {
+
+struct Frame {
+  explicit Frame(std::shared_ptr<const map::FrameData> d)
+      : data(std::move(d)),
+        points(data->keypoints.size(), nullptr),
+        point_outlier(data->keypoints.size(), false),
+        lines(data->lines.size(), nullptr),
+        line_outlier(data->lines.size(), false) {}
+
+  std::shared_ptr<const map::FrameData> data;
+  geometry::SE3 T_cw;
+  std::vector<map::MapPoint*> points;
+  std::vector<bool> point_outlier;
+  std::vector<map::MapLine*> lines;
+  std::vector<bool> line_outlier;
+  map::KeyFrame* reference = nullptr;
+
+  long id() const { return data->frame_id; }
+  Eigen::Vector3d camera_center() const { return T_cw.inverse().translation(); }
+  int num_matched_points() const;
+  int num_matched_lines() const;
+  // Drops the associations flagged as outliers (after pose optimisation).
+  void discard_outliers();
+};
+
+}  // namespace plslam::tracking

@@ -1,0 +1,125 @@
+#include "plslam/tracking/frame_extractor.h"
+
+#include <chrono>
+
+#include <tbb/task_group.h>
+
+#include "plslam/geometry/stereo_camera.h"
+#include "plslam/matching/stereo_point_frame.h"
+
+namespace plslam::tracking {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+FrameExtractorOptions FrameExtractorOptions::euroc() {
+  FrameExtractorOptions o;
+  o.orb = features::OrbOptions::euroc();
+  o.line_extractor = features::LineExtractorOptions::euroc();
+  return o;
+}
+
+FrameExtractorOptions FrameExtractorOptions::kitti() {
+  FrameExtractorOptions o;
+  o.orb = features::OrbOptions::kitti();
+  o.line_extractor = features::LineExtractorOptions::kitti();
+  return o;
+}
+
+FrameExtractor::FrameExtractor(const StereoCalibration& calib, FrameExtractorOptions options)
+    : calib_(calib),
+      options_(std::move(options)),
+      left_orb_(options_.orb),
+      right_orb_(matching::right_image_options(options_.orb, options_.right_points_factor)) {
+  options_.stereo_points.bf = calib_.bf();
+  options_.stereo_points.baseline = calib_.baseline;
+  options_.stereo_points.validate();
+}
+
+std::shared_ptr<map::FrameData> FrameExtractor::extract(long frame_id, double timestamp, const cv::Mat& left,
+                                                        const cv::Mat& right, FrameTimings* timings) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  features::PointFeatures pl, pr;
+  features::LineFeatures ll, lr;
+  features::ExtractionTimings tl;
+  features::LineTimings tll;
+  {
+    tbb::task_group tasks;
+    tasks.run([&] { pl = left_orb_.extract(left, &tl); });
+    tasks.run([&] { pr = right_orb_.extract(right); });
+    if (options_.lines) {
+      tasks.run([&] { ll = features::extract_lines(left, options_.line_extractor, &tll); });
+      tasks.run([&] { lr = features::extract_lines(right, options_.line_extractor); });
+    }
+    tasks.wait();
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  matching::StereoPointMatches sp;
+  std::vector<matching::StereoLineMatch> sl;
+  double sp_ms = 0, sl_ms = 0;
+  {
+    tbb::task_group tasks;
+    tasks.run([&] {
+      const auto s = std::chrono::steady_clock::now();
+      sp = matching::match_stereo_points(pl, pr, options_.stereo_points);
+      sp_ms = ms_since(s);
+    });
+    if (options_.lines) {
+      tasks.run([&] {
+        const auto s = std::chrono::steady_clock::now();
+        sl = matching::match_stereo_lines(ll, lr, calib_, options_.stereo_lines);
+        sl_ms = ms_since(s);
+      });
+    }
+    tasks.wait();
+  }
+  const auto t2 = std::chrono::steady_clock::now();
+
+  auto data = std::make_shared<map::FrameData>();
+  data->frame_id = frame_id;
+  data->timestamp = timestamp;
+  data->calib = calib_;
+  data->levels = options_.orb.levels;
+  data->scale_factor = options_.orb.scale_factor;
+  data->keypoints = std::move(pl.keypoints);
+  data->descriptors = pl.descriptors;
+  data->u_right = std::move(sp.u_right);
+  data->depth = std::move(sp.depth);
+  data->build_grid();
+
+  // Only stereo lines are kept: the optimisers' line term uses both images (the paper's eq. 8).
+  data->lines.reserve(sl.size());
+  data->line_descriptors = cv::Mat(static_cast<int>(sl.size()), 32, CV_8U);
+  for (const auto& m : sl) {
+    const auto& a = ll.lines[static_cast<std::size_t>(m.left)];
+    const auto& b = lr.lines[static_cast<std::size_t>(m.right)];
+    map::LineObservation obs;
+    obs.segment = a;
+    obs.left_line = geometry::line_through({a.start.x, a.start.y}, {a.end.x, a.end.y});
+    obs.right_line = geometry::line_through({b.start.x, b.start.y}, {b.end.x, b.end.y});
+    obs.stereo = true;
+    obs.start_cam = m.P_start;
+    obs.end_cam = m.P_end;
+    ll.descriptors.row(m.left).copyTo(data->line_descriptors.row(static_cast<int>(data->lines.size())));
+    data->lines.push_back(obs);
+  }
+
+  if (timings) {
+    timings->extraction_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    timings->stereo_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+    timings->total_ms = ms_since(t0);
+    timings->left_points = tl;
+    timings->left_lines = tll;
+    timings->stereo_points_ms = sp_ms;
+    timings->stereo_lines_ms = sl_ms;
+    timings->stereo_points = sp.matched;
+    timings->stereo_lines = static_cast<int>(sl.size());
+  }
+  return data;
+}
+
+}  // namespace plslam::tracking

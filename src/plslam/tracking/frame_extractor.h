@@ -1,0 +1,56 @@
+#pragma once
+// The paper's frame integration: four concurrent extraction tasks (left/right x points/lines),
+// then two concurrent stereo matching tasks (points, lines), assembled into one FrameData.
+#include <memory>
+
+#include <opencv2/core.hpp>
+
+#include "plslam/core/types.h"
+#include "plslam/features/line_extractor.h"
+#include "plslam/features/orb_extractor.h"
+#include "plslam/map/frame_data.h"
+#include "plslam/matching/stereo_line_matcher.h"
+#include "plslam/matching/stereo_point_matcher.h"
+
+namespace plslam::tracking {
+
+struct FrameExtractorOptions {
+  features::OrbOptions orb;
+  double right_points_factor = 2.0;  // right image keeps this many times more points (stereo recall)
+  matching::StereoPointOptions stereo_points;  // bf and baseline are filled from the calibration
+  bool lines = true;
+  features::LineExtractorOptions line_extractor;
+  matching::StereoLineMatchOptions stereo_lines;
+
+  static FrameExtractorOptions euroc();
+  static FrameExtractorOptions kitti();
+};
+
+struct FrameTimings {
+  double extraction_ms = 0;  // wall clock of the four extraction tasks
+  double stereo_ms = 0;      // wall clock of the two matching tasks
+  double total_ms = 0;       // extraction + stereo + assembly
+  features::ExtractionTimings left_points;
+  features::LineTimings left_lines;
+  double stereo_points_ms = 0, stereo_lines_ms = 0;
+  int stereo_points = 0, stereo_lines = 0;
+};
+
+class FrameExtractor {
+ public:
+  FrameExtractor(const StereoCalibration& calib, FrameExtractorOptions options);
+
+  std::shared_ptr<map::FrameData> extract(long frame_id, double timestamp, const cv::Mat& left,
+                                          const cv::Mat& right, FrameTimings* timings = nullptr) const;
+
+  const StereoCalibration& calibration() const { return calib_; }
+  const FrameExtractorOptions& options() const { return options_; }
+
+ private:
+  StereoCalibration calib_;
+  FrameExtractorOptions options_;
+  features::OrbExtractor left_orb_;
+  features::OrbExtractor right_orb_;
+};
+
+}  // namespace plslam::tracking

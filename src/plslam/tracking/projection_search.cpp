@@ -1,0 +1,236 @@
+#include "plslam/tracking/projection_search.h"
+
+#include <cmath>
+#include <limits>
+#include <unordered_set>
+
+#include <opencv2/features2d.hpp>
+
+#include "plslam/geometry/stereo_camera.h"
+#include "plslam/map/descriptor_utils.h"
+#include "plslam/map/keyframe.h"
+#include "plslam/map/map_line.h"
+#include "plslam/map/map_point.h"
+
+namespace plslam::tracking {
+namespace {
+
+bool slot_taken(const Frame& f, int j) {
+  const auto* p = f.points[static_cast<std::size_t>(j)];
+  return p && p->num_observations() > 0;
+}
+
+// Stereo consistency: a keypoint with a right match must also agree in u_r.
+bool stereo_consistent(const map::FrameData& d, int j, double u_right, double radius) {
+  const float ur = d.u_right[static_cast<std::size_t>(j)];
+  return ur < 0 || std::abs(u_right - ur) <= radius;
+}
+
+}  // namespace
+
+int search_points_from_frame(Frame& cur, const Frame& last, double radius, const SearchOptions& o) {
+  const auto& d = *cur.data;
+  const geometry::StereoCamera cam(d.calib);
+  int matches = 0;
+  for (std::size_t i = 0; i < last.points.size(); ++i) {
+    map::MapPoint* mp = last.points[i];
+    if (!mp || last.point_outlier[i] || mp->is_bad()) continue;
+    const Eigen::Vector3d Xc = cur.T_cw * mp->position();
+    if (Xc.z() <= 0) continue;
+    const Eigen::Vector2d uv = cam.project(Xc);
+    if (!cam.in_image(uv)) continue;
+    const int level = last.data->keypoints[i].octave;
+    const double r = radius * d.level_scale(level);
+    const auto candidates = d.points_in_area(uv.x(), uv.y(), r, std::max(0, level - 1), level + 1);
+    if (candidates.empty()) continue;
+    const cv::Mat desc = mp->descriptor();
+    if (desc.empty()) continue;
+    const double u_right = uv.x() - cam.bf() / Xc.z();
+    int best = std::numeric_limits<int>::max(), second = best, best_j = -1;
+    for (int j : candidates) {
+      if (slot_taken(cur, j) || !stereo_consistent(d, j, u_right, r)) continue;
+      const int dist = map::descriptor_distance(desc, d.descriptors.row(j));
+      if (dist < best) {
+        second = best;
+        best = dist;
+        best_j = j;
+      } else if (dist < second) {
+        second = dist;
+      }
+    }
+    // Low-threshold FAST packs many similar corners into a window: without the ratio test the
+    // nearest look-alike of the predicted position wins, which drags the pose towards the motion
+    // model's prediction and makes the velocity run away.
+    if (best_j >= 0 && best <= o.point_max_hamming && best < o.point_ratio * second) {
+      cur.points[static_cast<std::size_t>(best_j)] = mp;
+      cur.point_outlier[static_cast<std::size_t>(best_j)] = false;
+      ++matches;
+    }
+  }
+  return matches;
+}
+
+int search_points_in_local_map(Frame& cur, const std::vector<map::MapPoint*>& candidates_in, double radius,
+                               const SearchOptions& o) {
+  const auto& d = *cur.data;
+  const geometry::StereoCamera cam(d.calib);
+  std::unordered_set<const map::MapPoint*> already(cur.points.begin(), cur.points.end());
+  const geometry::SE3 T_wc = cur.T_cw.inverse();
+  const Eigen::Vector3d Ow = T_wc.translation();
+  int matches = 0;
+  for (map::MapPoint* mp : candidates_in) {
+    if (!mp || mp->is_bad() || already.count(mp)) continue;
+    const Eigen::Vector3d P = mp->position();
+    const Eigen::Vector3d Xc = cur.T_cw * P;
+    if (Xc.z() <= 0) continue;
+    const Eigen::Vector2d uv = cam.project(Xc);
+    if (!cam.in_image(uv)) continue;
+    const Eigen::Vector3d ray = P - Ow;
+    const double dist = ray.norm();
+    if (dist < mp->min_distance() || dist > mp->max_distance()) continue;
+    const double view_cos = ray.dot(mp->normal()) / dist;
+    if (view_cos < 0.5) continue;
+    mp->increase_visible();
+    const int level = mp->predict_level(dist, d.levels, d.scale_factor);
+    const double r = radius * (view_cos > 0.998 ? 2.5 : 4.0) * d.level_scale(level);
+    const auto candidates = d.points_in_area(uv.x(), uv.y(), r, std::max(0, level - 1), level);
+    if (candidates.empty()) continue;
+    const cv::Mat desc = mp->descriptor();
+    if (desc.empty()) continue;
+    const double u_right = uv.x() - cam.bf() / Xc.z();
+    int best = std::numeric_limits<int>::max(), second = best, best_j = -1, best_level = -1, second_level = -1;
+    for (int j : candidates) {
+      if (slot_taken(cur, j) || !stereo_consistent(d, j, u_right, r)) continue;
+      const int dist_h = map::descriptor_distance(desc, d.descriptors.row(j));
+      const int lvl = d.keypoints[static_cast<std::size_t>(j)].octave;
+      if (dist_h < best) {
+        second = best;
+        second_level = best_level;
+        best = dist_h;
+        best_level = lvl;
+        best_j = j;
+      } else if (dist_h < second) {
+        second = dist_h;
+        second_level = lvl;
+      }
+    }
+    if (best_j < 0 || best > o.point_max_hamming) continue;
+    if (best_level == second_level && best > o.point_ratio * second) continue;
+    cur.points[static_cast<std::size_t>(best_j)] = mp;
+    cur.point_outlier[static_cast<std::size_t>(best_j)] = false;
+    already.insert(mp);
+    ++matches;
+  }
+  return matches;
+}
+
+int search_lines(Frame& cur, const std::vector<map::MapLine*>& candidates, double radius, const SearchOptions& o) {
+  const auto& d = *cur.data;
+  if (d.lines.empty()) return 0;
+  const geometry::StereoCamera cam(d.calib);
+  std::unordered_set<const map::MapLine*> already(cur.lines.begin(), cur.lines.end());
+  const double cos_max_angle = std::cos(o.line_max_angle_deg * M_PI / 180.0);
+  int matches = 0;
+  for (map::MapLine* ml : candidates) {
+    if (!ml || ml->is_bad() || already.count(ml)) continue;
+    const Eigen::Vector3d s = cur.T_cw * ml->start();
+    const Eigen::Vector3d e = cur.T_cw * ml->end();
+    if (s.z() <= 0.05 || e.z() <= 0.05) continue;
+    const Eigen::Vector2d ps = cam.project(s), pe = cam.project(e);
+    if (!cam.in_image(ps) && !cam.in_image(pe)) continue;
+    const Eigen::Vector2d dir = pe - ps;
+    const double len = dir.norm();
+    if (len < 10) continue;
+    const Eigen::Vector2d u = dir / len;
+    const cv::Mat desc = ml->descriptor();
+    if (desc.empty()) continue;
+    ml->increase_visible();
+    int best = std::numeric_limits<int>::max(), best_j = -1;
+    for (std::size_t j = 0; j < d.lines.size(); ++j) {
+      if (cur.lines[j] && cur.lines[j]->num_observations() > 0) continue;
+      const auto& seg = d.lines[j].segment;
+      const Eigen::Vector2d a(seg.start.x, seg.start.y), b(seg.end.x, seg.end.y);
+      const Eigen::Vector2d v = b - a;
+      const double vlen = v.norm();
+      if (vlen < 1e-6 || std::abs(u.dot(v / vlen)) < cos_max_angle) continue;
+      const Eigen::Vector3d& l = d.lines[j].left_line;
+      if (std::abs(l.x() * ps.x() + l.y() * ps.y() + l.z()) > radius ||
+          std::abs(l.x() * pe.x() + l.y() * pe.y() + l.z()) > radius) {
+        continue;
+      }
+      // Overlap of the candidate with the projected segment, along the projected direction.
+      const double ta = u.dot(a - ps), tb = u.dot(b - ps);
+      const double overlap = std::min(std::max(ta, tb), len) - std::max(std::min(ta, tb), 0.0);
+      if (overlap < o.line_min_overlap * len) continue;
+      const int dist = map::descriptor_distance(desc, d.line_descriptors.row(static_cast<int>(j)));
+      if (dist < best) {
+        best = dist;
+        best_j = static_cast<int>(j);
+      }
+    }
+    if (best_j >= 0 && best <= o.line_max_hamming) {
+      cur.lines[static_cast<std::size_t>(best_j)] = ml;
+      cur.line_outlier[static_cast<std::size_t>(best_j)] = false;
+      already.insert(ml);
+      ++matches;
+    }
+  }
+  return matches;
+}
+
+int match_to_keyframe(Frame& cur, const map::KeyFrame& kf, double ratio, const SearchOptions& o) {
+  int matches = 0;
+  const auto& d = *cur.data;
+  cv::BFMatcher matcher(cv::NORM_HAMMING);
+  // Points.
+  {
+    std::vector<map::MapPoint*> pts;
+    cv::Mat descs;
+    for (auto* p : kf.map_points()) {
+      if (!p || p->is_bad()) continue;
+      const cv::Mat dsc = p->descriptor();
+      if (dsc.empty()) continue;
+      pts.push_back(p);
+      descs.push_back(dsc);
+    }
+    if (!pts.empty() && !d.descriptors.empty()) {
+      std::vector<std::vector<cv::DMatch>> knn;
+      matcher.knnMatch(descs, d.descriptors, knn, 2);
+      for (const auto& m : knn) {
+        if (m.empty() || m[0].distance > 50) continue;  // ORB-SLAM2's TH_LOW
+        if (m.size() > 1 && m[0].distance > ratio * m[1].distance) continue;
+        auto& slot = cur.points[static_cast<std::size_t>(m[0].trainIdx)];
+        if (slot) continue;
+        slot = pts[static_cast<std::size_t>(m[0].queryIdx)];
+        ++matches;
+      }
+    }
+  }
+  // Lines.
+  {
+    std::vector<map::MapLine*> ls;
+    cv::Mat descs;
+    for (auto* l : kf.map_lines()) {
+      if (!l || l->is_bad()) continue;
+      const cv::Mat dsc = l->descriptor();
+      if (dsc.empty()) continue;
+      ls.push_back(l);
+      descs.push_back(dsc);
+    }
+    if (!ls.empty() && !d.line_descriptors.empty()) {
+      std::vector<std::vector<cv::DMatch>> knn;
+      matcher.knnMatch(descs, d.line_descriptors, knn, 2);
+      for (const auto& m : knn) {
+        if (m.empty() || m[0].distance > o.line_max_hamming) continue;
+        if (m.size() > 1 && m[0].distance > ratio * m[1].distance) continue;
+        auto& slot = cur.lines[static_cast<std::size_t>(m[0].trainIdx)];
+        if (slot) continue;
+        slot = ls[static_cast<std::size_t>(m[0].queryIdx)];
+        ++matches;
+      }
+    }
+  }
+  return matches;
+}
+
+}  // namespace plslam::tracking

@@ -1,0 +1,37 @@
+#pragma once
+// Data association for tracking: map points and map lines are projected into the frame with its
+// current pose estimate, and matched by descriptor to the features found near the projection.
+#include <vector>
+
+#include "plslam/tracking/frame.h"
+
+namespace plslam::tracking {
+
+struct SearchOptions {
+  int point_max_hamming = 100;   // ORB-SLAM2's TH_HIGH
+  double point_ratio = 0.8;      // best < ratio * second best (local map search)
+  int line_max_hamming = 80;     // of 256 LBD bits
+  double line_max_angle_deg = 10;
+  double line_min_overlap = 0.3; // of the projected segment's length
+};
+
+// Matches the map points of `last` into `cur` within radius * scale(level) pixels of their
+// projection (ORB-SLAM2's motion-model search). Returns the number of new matches.
+int search_points_from_frame(Frame& cur, const Frame& last, double radius, const SearchOptions& o = {});
+
+// Matches `candidates` (visible map points of the local map not yet matched in `cur`). The
+// radius grows when the viewing direction differs from the point's mean one.
+int search_points_in_local_map(Frame& cur, const std::vector<map::MapPoint*>& candidates, double radius,
+                               const SearchOptions& o = {});
+
+// Matches map lines projected with cur.T_cw: a candidate frame line must be nearly parallel to the
+// projected segment, lie within `radius` pixels of it (both endpoints' distances to the candidate
+// line) and overlap it; the smallest LBD distance under the threshold wins.
+int search_lines(Frame& cur, const std::vector<map::MapLine*>& candidates, double radius,
+                 const SearchOptions& o = {});
+
+// Descriptor-only matching of the frame to a keyframe's map points and lines (used to re-track
+// against the reference keyframe when the motion model fails; no vocabulary needed).
+int match_to_keyframe(Frame& cur, const map::KeyFrame& kf, double ratio = 0.75, const SearchOptions& o = {});
+
+}  // namespace plslam::tracking

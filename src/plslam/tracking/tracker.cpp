@@ -1,0 +1,417 @@
+#include "plslam/tracking/tracker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <numeric>
+#include <unordered_set>
+
+#include <spdlog/spdlog.h>
+
+#include "plslam/geometry/stereo_camera.h"
+
+namespace plslam::tracking {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+}  // namespace
+
+const char* to_string(TrackingState s) {
+  switch (s) {
+    case TrackingState::kNotInitialized: return "INIT";
+    case TrackingState::kOk: return "OK";
+    case TrackingState::kLost: return "LOST";
+  }
+  return "?";
+}
+
+Tracker::Tracker(map::Map& map, TrackerOptions options, std::function<void(map::KeyFrame*)> insert_keyframe,
+                 std::function<bool()> mapping_idle)
+    : map_(map),
+      options_(std::move(options)),
+      insert_keyframe_(std::move(insert_keyframe)),
+      mapping_idle_(std::move(mapping_idle)),
+      policy_(options_.keyframe) {}
+
+double Tracker::close_depth(const Frame& f) const {
+  return options_.close_depth_baselines * f.data->calib.baseline;
+}
+
+geometry::SE3 Tracker::pose_of(const FrameRecord& r) {
+  geometry::SE3 T_cr = r.T_cr;
+  map::KeyFrame* ref = r.reference;
+  // Culled keyframes hand their frames over to their parents.
+  while (ref && ref->is_bad()) {
+    T_cr = T_cr * ref->pose_relative_to_parent();
+    ref = ref->parent();
+  }
+  return ref ? T_cr * ref->pose() : T_cr;
+}
+
+TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
+  Frame f(std::move(data));
+  TrackResult result;
+  // Tracking reads poses and structure that local BA writes: hold the map-update lock for the
+  // whole step so it never sees half an update.
+  std::unique_lock map_lock(map_.update_mutex());
+
+  bool ok = false;
+  if (state_ == TrackingState::kNotInitialized || state_ == TrackingState::kLost) {
+    if (state_ == TrackingState::kLost && last_) {
+      // A new map segment starts where the motion model puts the camera, so the trajectory stays
+      // continuous across the loss.
+      f.T_cw = velocity_ ? (*velocity_ * last_->T_cw).normalized() : last_->T_cw;
+    }
+    ok = initialize(f);
+    if (ok) {
+      result.keyframe = true;
+      state_ = TrackingState::kOk;
+    }
+  } else {
+    bool tracked = false;
+    if (velocity_) tracked = track_with_motion_model(f, result.times);
+    if (!tracked) tracked = track_reference_keyframe(f, result.times);
+    if (tracked) {
+      tracked = track_local_map(f, result.times, result.point_inliers, result.line_inliers);
+    }
+    if (tracked) {
+      ok = true;
+      velocity_ = (f.T_cw * last_->T_cw.inverse()).normalized();
+      const auto inputs = keyframe_inputs(f, result.point_inliers, result.line_inliers);
+      result.decision = policy_.decide(inputs);
+      if (result.decision.insert) {
+        create_keyframe(f);
+        policy_.keyframe_inserted(inputs);
+        result.keyframe = true;
+      }
+      f.discard_outliers();
+    } else {
+      ++lost_events_;
+      spdlog::warn("frame {}: tracking lost (event {}), starting a new map segment", f.id(), lost_events_);
+      state_ = TrackingState::kLost;
+      // Keep a pose for the trajectory: the motion model's prediction.
+      f.T_cw = velocity_ && last_ ? (*velocity_ * last_->T_cw).normalized() : (last_ ? last_->T_cw : f.T_cw);
+      std::fill(f.points.begin(), f.points.end(), nullptr);
+      std::fill(f.lines.begin(), f.lines.end(), nullptr);
+    }
+  }
+
+  if (!f.reference) f.reference = reference_;
+  FrameRecord rec;
+  rec.frame_id = f.id();
+  rec.timestamp = f.data->timestamp;
+  rec.reference = f.reference;
+  rec.T_cr = f.reference ? f.T_cw * f.reference->pose_inverse() : f.T_cw;
+  rec.tracked = ok;
+  records_.push_back(rec);
+  if (!ok && state_ == TrackingState::kNotInitialized) {
+    // Not enough stereo points yet: nothing to track against, keep waiting.
+  }
+  result.state = state_;
+  last_ = std::move(f);
+  return result;
+}
+
+bool Tracker::initialize(Frame& f) {
+  const auto& d = *f.data;
+  int stereo = 0;
+  for (float z : d.depth) stereo += z > 0;
+  if (stereo < options_.init_min_points) return false;
+  map::KeyFrame* kf = map_.create_keyframe(f.data, f.T_cw);
+  const geometry::StereoCamera cam(d.calib);
+  const geometry::SE3 T_wc = f.T_cw.inverse();
+  for (std::size_t i = 0; i < d.keypoints.size(); ++i) {
+    if (d.depth[i] <= 0) continue;
+    const Eigen::Vector3d Xc = cam.unproject({d.keypoints[i].pt.x, d.keypoints[i].pt.y}, d.depth[i]);
+    map::MapPoint* mp = map_.create_point(T_wc * Xc, kf, f.id());
+    mp->add_observation(kf, static_cast<int>(i));
+    kf->add_map_point(mp, static_cast<int>(i));
+    mp->update_descriptor();
+    mp->update_normal_and_depth();
+    f.points[i] = mp;
+  }
+  if (options_.lines) {
+    for (std::size_t j = 0; j < d.lines.size(); ++j) {
+      const auto& l = d.lines[j];
+      if (!l.stereo) continue;
+      map::MapLine* ml = map_.create_line(T_wc * l.start_cam, T_wc * l.end_cam, kf, f.id());
+      ml->add_observation(kf, static_cast<int>(j));
+      kf->add_map_line(ml, static_cast<int>(j));
+      ml->update_descriptor();
+      ml->update_normal_and_depth();
+      f.lines[j] = ml;
+    }
+  }
+  f.reference = kf;
+  reference_ = kf;
+  last_keyframe_ = kf;
+  local_keyframes_ = {kf};
+  velocity_.reset();
+  insert_keyframe_(kf);
+  KeyframeInputs in;
+  in.frame_id = f.id();
+  in.timestamp = d.timestamp;
+  in.position = T_wc.translation();
+  policy_.keyframe_inserted(in);
+  spdlog::info("frame {}: new map segment with {} points and {} lines", f.id(), map_.num_points(),
+               map_.num_lines());
+  return true;
+}
+
+int Tracker::optimize_pose(Frame& f, TrackStageTimes& t) {
+  const auto t0 = Clock::now();
+  const auto& d = *f.data;
+  std::vector<optim::PosePointTerm> pts;
+  std::vector<std::size_t> pidx;
+  for (std::size_t i = 0; i < f.points.size(); ++i) {
+    map::MapPoint* mp = f.points[i];
+    if (!mp) continue;
+    optim::PosePointTerm term;
+    term.world = mp->position();
+    term.obs.measurement = {d.keypoints[i].pt.x, d.keypoints[i].pt.y, d.u_right[i]};
+    term.obs.has_right = d.u_right[i] >= 0;
+    term.obs.level = d.keypoints[i].octave;
+    pts.push_back(term);
+    pidx.push_back(i);
+  }
+  std::vector<optim::PoseLineTerm> lns;
+  std::vector<std::size_t> lidx;
+  for (std::size_t j = 0; j < f.lines.size(); ++j) {
+    map::MapLine* ml = f.lines[j];
+    if (!ml) continue;
+    optim::PoseLineTerm term;
+    term.start = ml->start();
+    term.end = ml->end();
+    term.obs.left_line = d.lines[j].left_line;
+    term.obs.right_line = d.lines[j].right_line;
+    term.obs.information = options_.line_information;
+    lns.push_back(term);
+    lidx.push_back(j);
+  }
+  const geometry::StereoCamera cam(d.calib);
+  auto popts = options_.pose;
+  popts.scale_factor = d.scale_factor;
+  const auto r = optim::optimize_pose(cam, f.T_cw, pts, lns, popts);
+  f.T_cw = r.T_cw.normalized();
+  for (std::size_t k = 0; k < pidx.size(); ++k) f.point_outlier[pidx[k]] = r.point_outlier[k];
+  for (std::size_t k = 0; k < lidx.size(); ++k) f.line_outlier[lidx[k]] = r.line_outlier[k];
+  t.pose_optimization_ms += ms_since(t0);
+  return r.num_point_inliers + r.num_line_inliers;
+}
+
+bool Tracker::track_with_motion_model(Frame& f, TrackStageTimes& t) {
+  const auto t0 = Clock::now();
+  f.T_cw = (*velocity_ * last_->T_cw).normalized();
+  int n = search_points_from_frame(f, *last_, options_.motion_radius, options_.search);
+  if (n < options_.min_motion_matches) {
+    std::fill(f.points.begin(), f.points.end(), nullptr);
+    n = search_points_from_frame(f, *last_, 2 * options_.motion_radius, options_.search);
+  }
+  if (options_.lines) {
+    std::vector<map::MapLine*> last_lines;
+    for (std::size_t j = 0; j < last_->lines.size(); ++j) {
+      if (last_->lines[j] && !last_->line_outlier[j]) last_lines.push_back(last_->lines[j]);
+    }
+    n += search_lines(f, last_lines, options_.line_radius, options_.search);
+  }
+  bool ok = false;
+  if (n >= options_.min_motion_matches) {
+    const int inliers = optimize_pose(f, t);
+    f.discard_outliers();
+    ok = inliers >= options_.min_pose_inliers;
+  }
+  if (!ok) {
+    std::fill(f.points.begin(), f.points.end(), nullptr);
+    std::fill(f.lines.begin(), f.lines.end(), nullptr);
+  }
+  t.track_motion_ms += ms_since(t0);
+  return ok;
+}
+
+bool Tracker::track_reference_keyframe(Frame& f, TrackStageTimes& t) {
+  const auto t0 = Clock::now();
+  bool ok = false;
+  if (reference_) {
+    const int n = match_to_keyframe(f, *reference_, 0.75, options_.search);
+    if (n >= 15) {
+      f.T_cw = last_->T_cw;
+      const int inliers = optimize_pose(f, t);
+      f.discard_outliers();
+      ok = inliers >= options_.min_pose_inliers;
+    }
+  }
+  t.track_motion_ms += ms_since(t0);
+  return ok;
+}
+
+void Tracker::update_local_map(Frame& f) {
+  // Local keyframes: those observing the frame's matches, their best covisibles, and their
+  // spanning-tree neighbours.
+  std::map<map::KeyFrame*, int> counter;
+  for (std::size_t i = 0; i < f.points.size(); ++i) {
+    map::MapPoint* mp = f.points[i];
+    if (!mp || mp->is_bad()) {
+      f.points[i] = nullptr;
+      continue;
+    }
+    for (const auto& [kf, idx] : mp->observations()) ++counter[kf];
+  }
+  for (std::size_t j = 0; j < f.lines.size(); ++j) {
+    map::MapLine* ml = f.lines[j];
+    if (!ml || ml->is_bad()) {
+      f.lines[j] = nullptr;
+      continue;
+    }
+    for (const auto& [kf, idx] : ml->observations()) ++counter[kf];
+  }
+  local_keyframes_.clear();
+  std::unordered_set<map::KeyFrame*> in_set;
+  map::KeyFrame* best = nullptr;
+  int best_count = 0;
+  for (const auto& [kf, c] : counter) {
+    if (kf->is_bad()) continue;
+    if (c > best_count) {
+      best_count = c;
+      best = kf;
+    }
+    if (in_set.insert(kf).second) local_keyframes_.push_back(kf);
+  }
+  const std::size_t direct = local_keyframes_.size();
+  for (std::size_t k = 0; k < direct && local_keyframes_.size() < static_cast<std::size_t>(options_.local_keyframes_max); ++k) {
+    map::KeyFrame* kf = local_keyframes_[k];
+    for (auto* n : kf->best_covisibles(10)) {
+      if (!n->is_bad() && in_set.insert(n).second) local_keyframes_.push_back(n);
+    }
+    for (auto* c : kf->children()) {
+      if (!c->is_bad() && in_set.insert(c).second) local_keyframes_.push_back(c);
+    }
+    if (auto* p = kf->parent(); p && !p->is_bad() && in_set.insert(p).second) local_keyframes_.push_back(p);
+  }
+  if (best) {
+    reference_ = best;
+    f.reference = best;
+  }
+  local_points_.clear();
+  local_lines_.clear();
+  std::unordered_set<map::MapPoint*> seen_p(f.points.begin(), f.points.end());
+  std::unordered_set<map::MapLine*> seen_l(f.lines.begin(), f.lines.end());
+  for (auto* kf : local_keyframes_) {
+    for (auto* mp : kf->map_points()) {
+      if (mp && !mp->is_bad() && seen_p.insert(mp).second) local_points_.push_back(mp);
+    }
+    if (options_.lines) {
+      for (auto* ml : kf->map_lines()) {
+        if (ml && !ml->is_bad() && seen_l.insert(ml).second) local_lines_.push_back(ml);
+      }
+    }
+  }
+}
+
+bool Tracker::track_local_map(Frame& f, TrackStageTimes& t, int& point_inliers, int& line_inliers) {
+  const auto t0 = Clock::now();
+  update_local_map(f);
+  search_points_in_local_map(f, local_points_, options_.local_map_radius, options_.search);
+  if (options_.lines) search_lines(f, local_lines_, options_.line_radius, options_.search);
+  optimize_pose(f, t);
+  point_inliers = 0;
+  line_inliers = 0;
+  for (std::size_t i = 0; i < f.points.size(); ++i) {
+    map::MapPoint* mp = f.points[i];
+    if (!mp) continue;
+    if (f.point_outlier[i]) continue;
+    mp->increase_found();
+    if (mp->num_observations() > 0) ++point_inliers;
+  }
+  for (std::size_t j = 0; j < f.lines.size(); ++j) {
+    map::MapLine* ml = f.lines[j];
+    if (!ml || f.line_outlier[j]) continue;
+    ml->increase_found();
+    if (ml->num_observations() > 0) ++line_inliers;
+  }
+  t.track_local_map_ms += ms_since(t0);
+  return point_inliers + line_inliers >= options_.min_local_inliers;
+}
+
+KeyframeInputs Tracker::keyframe_inputs(const Frame& f, int point_inliers, int line_inliers) const {
+  KeyframeInputs in;
+  in.frame_id = f.id();
+  in.timestamp = f.data->timestamp;
+  in.position = f.T_cw.inverse().translation();
+  in.tracked_inliers = point_inliers + line_inliers;
+  const int nkf = static_cast<int>(map_.num_keyframes());
+  const int min_obs = nkf <= 2 ? 2 : 3;
+  in.reference_tracked = reference_ ? reference_->tracked_map_points(min_obs) + reference_->tracked_map_lines(min_obs) : 0;
+  in.keyframes_in_map = nkf;
+  in.local_mapping_idle = mapping_idle_();
+  const double th = close_depth(f);
+  for (std::size_t i = 0; i < f.points.size(); ++i) {
+    const float z = f.data->depth[i];
+    if (z <= 0 || z >= th) continue;
+    if (f.points[i] && !f.point_outlier[i]) {
+      ++in.tracked_close;
+    } else {
+      ++in.untracked_close;
+    }
+  }
+  return in;
+}
+
+map::KeyFrame* Tracker::create_keyframe(Frame& f) {
+  const auto& d = *f.data;
+  map::KeyFrame* kf = map_.create_keyframe(f.data, f.T_cw);
+  const geometry::StereoCamera cam(d.calib);
+  const geometry::SE3 T_wc = f.T_cw.inverse();
+  // Tracked map points and lines: associated now, observations added by local mapping.
+  for (std::size_t i = 0; i < f.points.size(); ++i) {
+    if (f.points[i] && !f.point_outlier[i]) kf->add_map_point(f.points[i], static_cast<int>(i));
+  }
+  for (std::size_t j = 0; j < f.lines.size(); ++j) {
+    if (f.lines[j] && !f.line_outlier[j]) kf->add_map_line(f.lines[j], static_cast<int>(j));
+  }
+  // New stereo points, closest first: all close ones, and at least new_keyframe_points.
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < d.depth.size(); ++i) {
+    if (d.depth[i] > 0) order.push_back(i);
+  }
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return d.depth[a] < d.depth[b]; });
+  const double th = close_depth(f);
+  int count = 0;
+  for (std::size_t i : order) {
+    if (d.depth[i] > th && count >= options_.new_keyframe_points) break;
+    ++count;
+    if (f.points[i] && !f.point_outlier[i] && f.points[i]->num_observations() > 0) continue;
+    const Eigen::Vector3d Xc = cam.unproject({d.keypoints[i].pt.x, d.keypoints[i].pt.y}, d.depth[i]);
+    map::MapPoint* mp = map_.create_point(T_wc * Xc, kf, f.id());
+    mp->add_observation(kf, static_cast<int>(i));
+    kf->add_map_point(mp, static_cast<int>(i));
+    mp->update_descriptor();
+    mp->update_normal_and_depth();
+    f.points[i] = mp;
+    f.point_outlier[i] = false;
+  }
+  if (options_.lines) {
+    for (std::size_t j = 0; j < d.lines.size(); ++j) {
+      const auto& l = d.lines[j];
+      if (!l.stereo || (f.lines[j] && !f.line_outlier[j])) continue;
+      if (0.5 * (l.start_cam.z() + l.end_cam.z()) > th) continue;
+      map::MapLine* ml = map_.create_line(T_wc * l.start_cam, T_wc * l.end_cam, kf, f.id());
+      ml->add_observation(kf, static_cast<int>(j));
+      kf->add_map_line(ml, static_cast<int>(j));
+      ml->update_descriptor();
+      ml->update_normal_and_depth();
+      f.lines[j] = ml;
+      f.line_outlier[j] = false;
+    }
+  }
+  reference_ = kf;
+  f.reference = kf;
+  last_keyframe_ = kf;
+  insert_keyframe_(kf);
+  return kf;
+}
+
+}  // namespace plslam::tracking

@@ -1,0 +1,111 @@
+#pragma once
+// The tracking thread's work for one frame (ORB-SLAM2's Tracking, with lines): stereo
+// initialisation, constant-velocity motion model with projection search, fall-back to the
+// reference keyframe, local map tracking, pose-only optimisation over points and lines, the
+// keyframe decision (PID + Kalman), and keyframe creation with new stereo points and lines.
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "plslam/geometry/se3.h"
+#include "plslam/map/map.h"
+#include "plslam/optim/pose_only.h"
+#include "plslam/tracking/frame.h"
+#include "plslam/tracking/keyframe_policy.h"
+#include "plslam/tracking/projection_search.h"
+
+namespace plslam::tracking {
+
+struct TrackerOptions {
+  int init_min_points = 500;          // stereo points needed to start a map
+  double close_depth_baselines = 40;  // "close" stereo points: depth < 40 baselines (ORB-SLAM2)
+  int new_keyframe_points = 100;      // a keyframe creates at least this many points (closest first)
+  double motion_radius = 7.0;         // px at level 0, motion-model search (ORB-SLAM2 stereo)
+  double local_map_radius = 1.0;      // px factor, local-map search (times 2.5 or 4 and the level scale)
+  double line_radius = 8.0;           // px, line search
+  int min_motion_matches = 20;
+  int min_pose_inliers = 10;
+  int min_local_inliers = 30;
+  bool lines = true;
+  double line_information = 0.5;      // the paper's line information
+  SearchOptions search;
+  optim::PoseOnlyOptions pose;
+  KeyframePolicyOptions keyframe;
+  int local_keyframes_max = 80;
+};
+
+enum class TrackingState { kNotInitialized, kOk, kLost };
+const char* to_string(TrackingState s);
+
+struct TrackStageTimes {
+  double track_motion_ms = 0;     // motion model or reference keyframe, search + optimisation
+  double track_local_map_ms = 0;  // local map search + optimisation
+  double pose_optimization_ms = 0;  // the optimisations alone (part of the two above)
+};
+
+struct TrackResult {
+  TrackingState state = TrackingState::kNotInitialized;
+  int point_inliers = 0;
+  int line_inliers = 0;
+  bool keyframe = false;
+  KeyframeDecision decision;
+  TrackStageTimes times;
+};
+
+// One row per processed frame: its pose is T_cr · T_rw, relative to its reference keyframe, so
+// it follows the keyframe when bundle adjustment moves it (ORB-SLAM2's trajectory bookkeeping).
+struct FrameRecord {
+  long frame_id = 0;
+  double timestamp = 0;
+  map::KeyFrame* reference = nullptr;
+  geometry::SE3 T_cr;
+  bool tracked = false;
+};
+
+class Tracker {
+ public:
+  // `insert_keyframe` hands a new keyframe to local mapping; `mapping_idle` tells whether local
+  // mapping accepts keyframes right now.
+  Tracker(map::Map& map, TrackerOptions options, std::function<void(map::KeyFrame*)> insert_keyframe,
+          std::function<bool()> mapping_idle);
+
+  TrackResult track(std::shared_ptr<const map::FrameData> data);
+
+  TrackingState state() const { return state_; }
+  int lost_events() const { return lost_events_; }
+  const std::vector<FrameRecord>& records() const { return records_; }
+  // The pose of a record with every keyframe's current estimate (call with local mapping idle).
+  static geometry::SE3 pose_of(const FrameRecord& r);
+  const Frame* last_frame() const { return last_ ? &*last_ : nullptr; }
+
+ private:
+  bool initialize(Frame& f);
+  bool track_with_motion_model(Frame& f, TrackStageTimes& t);
+  bool track_reference_keyframe(Frame& f, TrackStageTimes& t);
+  bool track_local_map(Frame& f, TrackStageTimes& t, int& point_inliers, int& line_inliers);
+  int optimize_pose(Frame& f, TrackStageTimes& t);
+  void update_local_map(Frame& f);
+  map::KeyFrame* create_keyframe(Frame& f);
+  KeyframeInputs keyframe_inputs(const Frame& f, int point_inliers, int line_inliers) const;
+  double close_depth(const Frame& f) const;
+
+  map::Map& map_;
+  TrackerOptions options_;
+  std::function<void(map::KeyFrame*)> insert_keyframe_;
+  std::function<bool()> mapping_idle_;
+  KeyframePolicy policy_;
+
+  TrackingState state_ = TrackingState::kNotInitialized;
+  std::optional<Frame> last_;
+  std::optional<geometry::SE3> velocity_;  // T_cur_last of the previous step
+  map::KeyFrame* reference_ = nullptr;
+  map::KeyFrame* last_keyframe_ = nullptr;
+  std::vector<map::KeyFrame*> local_keyframes_;
+  std::vector<map::MapPoint*> local_points_;
+  std::vector<map::MapLine*> local_lines_;
+  std::vector<FrameRecord> records_;
+  int lost_events_ = 0;
+};
+
+}  // namespace plslam::tracking

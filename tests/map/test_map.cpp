@@ -1,0 +1,160 @@
+#include <gtest/gtest.h>
+
+#include "plslam/map/descriptor_utils.h"
+#include "plslam/map/map.h"
+
+namespace plslam::map {
+namespace {
+
+std::shared_ptr<FrameData> make_data(long id, int n_points, int n_lines = 0) {
+  auto d = std::make_shared<FrameData>();
+  d->frame_id = id;
+  d->calib.width = 640;
+  d->calib.height = 480;
+  d->calib.fx = d->calib.fy = 500;
+  d->calib.cx = 320;
+  d->calib.cy = 240;
+  d->calib.baseline = 0.1;
+  cv::RNG rng(static_cast<std::uint64_t>(id) + 1);
+  for (int i = 0; i < n_points; ++i) {
+    d->keypoints.emplace_back(cv::Point2f(rng.uniform(0.f, 640.f), rng.uniform(0.f, 480.f)), 31.f, 0.f, 0.f, 0);
+    d->u_right.push_back(-1);
+    d->depth.push_back(-1);
+  }
+  d->descriptors = cv::Mat(n_points, 32, CV_8U);
+  rng.fill(d->descriptors, cv::RNG::UNIFORM, 0, 256);
+  d->lines.resize(static_cast<std::size_t>(n_lines));
+  d->line_descriptors = cv::Mat(n_lines, 32, CV_8U);
+  if (n_lines > 0) rng.fill(d->line_descriptors, cv::RNG::UNIFORM, 0, 256);
+  d->build_grid();
+  return d;
+}
+
+// Three keyframes: 0 and 1 share 30 points, 1 and 2 share 20, 0 and 2 share 5.
+struct Fixture {
+  Map map;
+  KeyFrame* k[3];
+  Fixture() {
+    for (int i = 0; i < 3; ++i) k[i] = map.create_keyframe(make_data(i, 100), geometry::SE3());
+    int next[3] = {0, 0, 0};
+    auto share = [&](int a, int b, int n) {
+      for (int s = 0; s < n; ++s) {
+        MapPoint* p = map.create_point(Eigen::Vector3d(s, a, b), k[a], 0);
+        for (int kf : {a, b}) {
+          p->add_observation(k[kf], next[kf]);
+          k[kf]->add_map_point(p, next[kf]++);
+        }
+      }
+    };
+    share(0, 1, 30);
+    share(1, 2, 20);
+    share(0, 2, 5);
+    for (auto* kf : k) kf->update_connections();
+  }
+};
+
+TEST(Map, CovisibilityWeightsCountSharedPoints) {
+  Fixture f;
+  EXPECT_EQ(f.k[0]->weight(f.k[1]), 30);
+  EXPECT_EQ(f.k[1]->weight(f.k[2]), 20);
+  // Below 15 shared points there is no edge, except to a keyframe's strongest neighbour.
+  EXPECT_EQ(f.k[0]->weight(f.k[2]), 0);
+  EXPECT_EQ(f.k[1]->covisibles(), (std::vector<KeyFrame*>{f.k[0], f.k[2]}));
+  EXPECT_EQ(f.k[1]->best_covisibles(1), (std::vector<KeyFrame*>{f.k[0]}));
+}
+
+TEST(Map, SpanningTreeAttachesToStrongestNeighbour) {
+  Fixture f;
+  EXPECT_EQ(f.k[0]->parent(), nullptr);
+  EXPECT_EQ(f.k[1]->parent(), f.k[0]);
+  EXPECT_EQ(f.k[2]->parent(), f.k[1]);
+  EXPECT_TRUE(f.k[0]->children().count(f.k[1]));
+}
+
+TEST(Map, CullingAKeyframeReparentsChildrenAndKeepsRelativePose) {
+  Fixture f;
+  f.k[1]->set_pose(geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1, 0, 0)));
+  f.k[1]->set_bad();
+  f.map.erase_keyframe(f.k[1]);
+  EXPECT_TRUE(f.k[1]->is_bad());
+  EXPECT_EQ(f.k[2]->parent(), f.k[0]);
+  EXPECT_EQ(f.map.num_keyframes(), 2u);
+  EXPECT_NEAR((f.k[1]->pose_relative_to_parent().translation() - Eigen::Vector3d(1, 0, 0)).norm(), 0, 1e-12);
+  // Points seen only by k0 and k1 lost their second observation and are gone.
+  EXPECT_EQ(f.map.num_points(), 5u);
+  EXPECT_EQ(f.k[0]->tracked_map_points(1), 5);
+}
+
+TEST(Map, FirstKeyframeIsNeverCulled) {
+  Fixture f;
+  f.k[0]->set_bad();
+  EXPECT_FALSE(f.k[0]->is_bad());
+}
+
+TEST(Map, ReplacingAPointMovesItsObservations) {
+  Map map;
+  KeyFrame* a = map.create_keyframe(make_data(0, 10), geometry::SE3());
+  KeyFrame* b = map.create_keyframe(make_data(1, 10), geometry::SE3());
+  KeyFrame* c = map.create_keyframe(make_data(2, 10), geometry::SE3());
+  MapPoint* p = map.create_point({0, 0, 1}, a, 0);
+  MapPoint* q = map.create_point({0, 0, 1.01}, b, 1);
+  p->add_observation(a, 3);
+  a->add_map_point(p, 3);
+  p->add_observation(c, 4);
+  c->add_map_point(p, 4);
+  q->add_observation(b, 5);
+  b->add_map_point(q, 5);
+  q->add_observation(c, 4);
+  c->add_map_point(q, 4);
+  p->replace_with(q);
+  EXPECT_TRUE(p->is_bad());
+  EXPECT_EQ(p->replaced_by(), q);
+  EXPECT_EQ(q->num_observations(), 3);
+  EXPECT_EQ(a->map_point(3), q);
+  EXPECT_EQ(c->map_point(4), q);
+  EXPECT_EQ(map.num_points(), 1u);
+}
+
+TEST(Map, PointWithOneObservationLeftBecomesBad) {
+  Map map;
+  KeyFrame* a = map.create_keyframe(make_data(0, 10), geometry::SE3());
+  KeyFrame* b = map.create_keyframe(make_data(1, 10), geometry::SE3());
+  MapPoint* p = map.create_point({0, 0, 1}, a, 0);
+  p->add_observation(a, 0);
+  a->add_map_point(p, 0);
+  p->add_observation(b, 0);
+  b->add_map_point(p, 0);
+  p->erase_observation(b);
+  EXPECT_TRUE(p->is_bad());
+  EXPECT_EQ(a->map_point(0), nullptr);
+}
+
+TEST(Map, MostDistinctiveDescriptorHasSmallestMedianDistance) {
+  // A central descriptor, three that each differ from it in 4 other bits, and a far one.
+  auto with_bits = [](int from, int to) {
+    cv::Mat m(1, 32, CV_8U, cv::Scalar(0));
+    for (int b = from; b < to; ++b) m.at<uchar>(0, b / 8) |= static_cast<uchar>(1 << (b % 8));
+    return m;
+  };
+  const std::vector<cv::Mat> d{with_bits(0, 4), with_bits(0, 0), with_bits(4, 8), with_bits(8, 12),
+                               with_bits(100, 160)};
+  // Median distances (self included, as ORB-SLAM2): central 4, the others 8, the far one 60+.
+  EXPECT_EQ(descriptor_distance(most_distinctive(d), d[1]), 0);
+  EXPECT_TRUE(most_distinctive({}).empty());
+}
+
+TEST(FrameData, GridSearchFindsExactlyThePointsInTheRadius) {
+  auto d = make_data(0, 500);
+  const double u = 300, v = 200, r = 40;
+  auto found = d->points_in_area(u, v, r);
+  std::sort(found.begin(), found.end());
+  std::vector<int> brute;
+  for (std::size_t i = 0; i < d->keypoints.size(); ++i) {
+    if (std::hypot(d->keypoints[i].pt.x - u, d->keypoints[i].pt.y - v) <= r) brute.push_back(static_cast<int>(i));
+  }
+  EXPECT_EQ(found, brute);
+  EXPECT_FALSE(brute.empty());
+}
+
+}  // namespace
+}  // namespace plslam::map

@@ -1,0 +1,125 @@
+// End-to-end: `plslam run` on a short synthetic sequence (always) and on KITTI 06 (when the shared
+// data is there), checking the outputs and ATE bounds.
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "plslam/io/trajectory_io.h"
+#include "support/test_support.h"
+
+namespace plslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+nlohmann::json read_json(const fs::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+std::size_t count_lines(const fs::path& p) {
+  std::ifstream in(p);
+  std::size_t n = 0;
+  std::string line;
+  while (std::getline(in, line)) n += !line.empty() && line[0] != '#';
+  return n;
+}
+
+std::string head(const fs::path& p, int lines) {
+  std::ifstream in(p);
+  std::string out, line;
+  for (int i = 0; i < lines && std::getline(in, line); ++i) out += line + "\n";
+  return out;
+}
+
+void expect_outputs(const fs::path& out, std::size_t frames) {
+  EXPECT_EQ(count_lines(out / "trajectory.tum"), frames);
+  EXPECT_GT(count_lines(out / "keyframes.tum"), 0u);
+  EXPECT_NE(head(out / "map_points.ply", 6).find("element vertex"), std::string::npos);
+  EXPECT_NE(head(out / "map_lines.ply", 6).find("element vertex"), std::string::npos);
+  const auto stats = read_json(out / "stats.json");
+  for (const char* key : {"frames", "tracked_frames", "lost_events", "keyframes", "map_points", "map_lines",
+                          "tracking_ms", "stages_ms", "local_ba_ms"}) {
+    EXPECT_TRUE(stats.contains(key)) << key;
+  }
+  for (const char* key : {"median", "mean", "p90", "max"}) EXPECT_TRUE(stats["tracking_ms"].contains(key)) << key;
+  for (const char* key : {"extraction", "stereo_matching", "track_motion", "track_local_map", "pose_optimization"}) {
+    EXPECT_TRUE(stats["stages_ms"].contains(key)) << key;
+  }
+}
+
+TEST(RunEndToEnd, SyntheticOfficeIsTrackedWithSmallError) {
+  test::TempDir tmp;
+  const auto seq = tmp.path() / "office";
+  const auto synth = test::run_cli("synth --out \"" + seq.string() + "\" --scene office --frames 120 --seed 3");
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  const auto out = tmp.path() / "run";
+  const auto r = test::run_cli("run \"" + seq.string() + "\" --out \"" + out.string() + "\" --quiet --sequential");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  expect_outputs(out, 120);
+  const auto stats = read_json(out / "stats.json");
+  EXPECT_EQ(stats["tracked_frames"], 120);
+  EXPECT_EQ(stats["lost_events"], 0);
+  EXPECT_GT(stats["map_lines"].get<int>(), 0);
+  // Under 1 % of the path length (the issue's bound), with the exact rendered ground truth.
+  const auto info = test::run_cli("info --json \"" + seq.string() + "\"");
+  const double path = nlohmann::json::parse(info.out)["gt_path_length_m"].get<double>();
+  const double ate = stats["accuracy"]["ape_trans_m"]["rmse"].get<double>();
+  RecordProperty("ate_m", std::to_string(ate));
+  RecordProperty("path_m", std::to_string(path));
+  EXPECT_LT(ate, 0.01 * path);
+}
+
+TEST(RunEndToEnd, Kitti06IsTrackedWithinBound) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto out = tmp.path() / "run";
+  const auto r = test::run_cli("run \"" + (data / "kitti/sequences/06").string() + "\" --out \"" + out.string() +
+                               "\" --quiet --sequential");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  expect_outputs(out, 51);
+  EXPECT_EQ(count_lines(out / "trajectory.kitti"), 51u);
+  const auto stats = read_json(out / "stats.json");
+  EXPECT_EQ(stats["tracked_frames"], 51);
+  EXPECT_EQ(stats["lost_events"], 0);
+  const double ate = stats["accuracy"]["ape_trans_m"]["rmse"].get<double>();
+  RecordProperty("ate_m", std::to_string(ate));
+  // ORB-SLAM3 gets 0.042 m on these frames; the issue's target is 0.063 m. This bound guards
+  // against regressions (tracking failures give metres), not the target itself.
+  EXPECT_LT(ate, 0.15);
+}
+
+TEST(RunEndToEnd, UnknownConfigKeyIsAnErrorNamingIt) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto cfg = tmp.path() / "bad.yaml";
+  std::ofstream(cfg) << "keyframe:\n  ratio: 0.75\n  pidd: true\n";
+  const auto r = test::run_cli("run \"" + (data / "kitti/sequences/06").string() + "\" --out \"" +
+                               (tmp.path() / "o").string() + "\" --config \"" + cfg.string() + "\"");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown key 'keyframe.pidd'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bad.yaml"), std::string::npos) << r.err;
+}
+
+TEST(RunEndToEnd, ShippedConfigsAreValid) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  for (const char* name : {"euroc.yaml", "kitti.yaml"}) {
+    test::TempDir tmp;
+    const fs::path cfg = fs::path(PLSLAM_SOURCE_DIR) / "config" / name;
+    const auto r = test::run_cli("run \"" + (data / "kitti/sequences/06").string() + "\" --max-frames 3 --quiet --out \"" +
+                                 (tmp.path() / "o").string() + "\" --config \"" + cfg.string() + "\"");
+    EXPECT_EQ(r.exit_code, 0) << name << ": " << r.err;
+  }
+}
+
+TEST(RunEndToEnd, MissingDatasetIsExitCode2) {
+  test::TempDir tmp;
+  const auto r = test::run_cli("run /nonexistent/seq --out \"" + (tmp.path() / "o").string() + "\"");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("no such folder"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace plslam
