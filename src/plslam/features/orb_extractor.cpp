@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 
-#include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "plslam/core/error.h"
@@ -35,7 +34,7 @@ constexpr int kIniMinCell = 30;
 // ORB-SLAM2 does costs ~40 % more here because of the many small calls.
 void detect_ini_min(const cv::Mat& region, const OrbOptions& o, std::vector<cv::KeyPoint>& out) {
   std::vector<cv::KeyPoint> all;
-  cv::FAST(region, all, o.fast_min_threshold, true);
+  detect_fast(region, o.fast_min_threshold, all, o.fast_impl);
   const int inner_w = region.cols - 2 * kFastRadius, inner_h = region.rows - 2 * kFastRadius;
   const int n_cols = std::max(1, inner_w / kIniMinCell), n_rows = std::max(1, inner_h / kIniMinCell);
   const int cell_w = (inner_w + n_cols - 1) / n_cols, cell_h = (inner_h + n_rows - 1) / n_rows;
@@ -77,6 +76,7 @@ void OrbOptions::validate() const {
     if (t < 1 || t > 254) fail("FAST thresholds must be in [1, 254]");
   if (fast_min_threshold > fast_ini_threshold) fail("fast_min_threshold must not exceed fast_ini_threshold");
   if (!(ssc_tolerance >= 0.0 && ssc_tolerance < 0.5)) fail("ssc_tolerance must be in [0, 0.5)");
+  if (!fast_impl_available(fast_impl)) fail(std::string("FAST implementation ") + to_string(fast_impl) + " is not available on this CPU");
   if (edge_margin < kFastRadius || edge_margin > 64) fail("edge_margin must be in [3, 64]");
 }
 
@@ -101,7 +101,7 @@ PyramidCandidates OrbExtractor::detect(const ImagePyramid& pyramid) const {
     }
     const cv::Mat region = img(cv::Rect(lc.offset, lc.region));
     if (options_.fast_mode == FastMode::kSingle) {
-      cv::FAST(region, lc.keypoints, options_.fast_threshold, true);
+      detect_fast(region, options_.fast_threshold, lc.keypoints, options_.fast_impl);
     } else {
       detect_ini_min(region, options_, lc.keypoints);
     }

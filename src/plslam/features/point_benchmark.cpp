@@ -148,6 +148,7 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
                  {"fast_threshold", orb.fast_threshold},
                  {"fast_ini_threshold", orb.fast_ini_threshold},
                  {"fast_min_threshold", orb.fast_min_threshold},
+                 {"fast_impl", to_string(resolve_fast_impl(orb.fast_impl))},
                  {"ssc_tolerance", orb.ssc_tolerance},
                  {"right_feature_factor", options.right_feature_factor}};
   j["pyramid_ms"] = summarize(pyramid_ms);
