@@ -29,11 +29,12 @@ struct SscResult {
 // overshoots within the tolerance it is returned as is; when the search converges without
 // hitting the tolerance the best overshooting covering is cut to exactly `target` (the first
 // `target` kept points of a greedy pass are themselves a valid covering result).
-// `width_hint` (optional, > 0): a likely width, probed first together with its successor, so
-// that a good hint (e.g. the width found on the neighbouring pyramid level, where the per-level
-// target follows the level area and the width barely changes) ends the search after two passes.
-// The bisection between the closed-form bounds takes over when the hint is wrong; the result
-// depends on the hint only through which feasible width is found first.
+// `width_hint` (optional, > 0): a likely width, probed first and then galloped from (steps 1, 2,
+// 4, ... towards the outcome) until the outcome flips, so that a good hint (e.g. the width found
+// on the neighbouring pyramid level, where the per-level target follows the level area and the
+// width barely changes) ends the search after two or three passes. The bisection between the
+// closed-form bounds finishes inside the bracket; the result depends on the hint only through
+// which feasible width is found first.
 SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
                      double tolerance_fraction = 0.001, double width_hint = 0);
 
