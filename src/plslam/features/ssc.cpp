@@ -13,6 +13,10 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define PLSLAM_SSC_AVX2 1
+#endif
 
 namespace plslam::features {
 
@@ -74,6 +78,15 @@ std::vector<int> order_by_response(const std::vector<cv::KeyPoint>& keypoints) {
   return order;
 }
 
+namespace detail {
+namespace {
+thread_local bool portable_only = false;
+}
+bool ssc_portable_only() { return portable_only; }
+PortableSscScope::PortableSscScope() : previous_(portable_only) { portable_only = true; }
+PortableSscScope::~PortableSscScope() { portable_only = previous_; }
+}  // namespace detail
+
 namespace {
 
 // An uninitialised buffer that only grows: no allocation or zero-fill per call.
@@ -97,7 +110,7 @@ class Scratch {
 // call on the thread.
 struct Workspace {
   Scratch<int> index, kept, col_of_x, row_of_y;
-  Scratch<uint32_t> packed, pos;
+  Scratch<uint32_t> pos, position;
   Scratch<uint8_t> bin, grid;
 };
 Workspace& workspace() {
@@ -109,7 +122,7 @@ Workspace& workspace() {
 // packed as y << 16 | x. The covering works on whole pixels (FAST corners are whole pixels).
 struct SortedCandidates {
   const int* index;
-  const uint32_t* packed;
+  const uint32_t* position;
   int size;
 };
 
@@ -176,8 +189,8 @@ SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv:
   const int k = static_cast<int>(keypoints.size());
   const auto n = static_cast<std::size_t>(k);
   int* index = ws.index.get(n);
-  uint32_t* packed = ws.packed.get(n);
-  const SortedCandidates s{index, packed, k};
+  uint32_t* position = ws.position.get(n);
+  const SortedCandidates s{index, position, k};
   // Counting sort on integer scores (FAST's), descending and stable. The keypoints (28 bytes
   // each) are read once into compact bins and positions; counting and scattering work on those.
   uint8_t* bin = ws.bin.get(n);
@@ -186,7 +199,7 @@ SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv:
     const std::vector<int> order = order_by_response(keypoints);
     for (std::size_t i = 0; i < n; ++i) {
       index[i] = order[i];
-      packed[i] = pos[order[i]];
+      position[i] = pos[order[i]];
     }
     return s;
   }
@@ -218,9 +231,147 @@ SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv:
   for_each_part([&](int q, int i) {
     const int dst = next[static_cast<std::size_t>(q)][bin[i]]++;
     index[dst] = i;
-    packed[dst] = pos[i];
+    position[dst] = pos[i];
   });
   return s;
+}
+
+// The cell of pixel coordinate x at width w is floor(2x / w) (cells of side w/2), computed as
+// trunc((x + 1/4) * fl(2/w)) in float arithmetic, which SIMD code can do for many candidates at
+// once. Exact for x < 2^21: the true value (2x + 1/2)/w lies at least 1/(2w) away from an
+// integer, while the two float roundings move it by at most 2^-23 (2x + 1/2)/w, less than that.
+inline int cell_of(uint32_t x, float two_over_w) {
+  return static_cast<int>((static_cast<float>(x) + 0.25f) * two_over_w);
+}
+
+// The cover grid of one pass: w/2 cells plus two margin cells on each side, so that covering a
+// 5x5 block needs no bounds checks; 4 spare bytes for 32-bit gathers at the last cell.
+struct Grid {
+  int w, cols, rows, stride;
+  float two_over_w;
+  std::size_t cells;
+  Grid(cv::Size size, int width)
+      : w(width),
+        cols((2 * (size.width - 1)) / width + 1),
+        rows((2 * (size.height - 1)) / width + 1),
+        stride(cols + 4),
+        two_over_w(2.0f / static_cast<float>(width)),
+        cells(static_cast<std::size_t>(stride) * static_cast<std::size_t>(rows + 4)) {}
+  int cell_of_coordinate(uint32_t x) const { return cell_of(x, two_over_w); }
+  int cell(uint32_t packed) const {
+    return (cell_of(packed >> 16, two_over_w) + 2) * stride + cell_of(packed & 0xFFFFu, two_over_w) + 2;
+  }
+};
+
+inline void mark_cover(uint8_t* cell, int stride) {
+  for (int dy = -2; dy <= 2; ++dy) {
+    uint8_t* row = cell + dy * stride;
+    row[-2] = row[-1] = row[0] = row[1] = row[2] = 1;
+  }
+}
+
+// Keeps the candidates of one block of up to 32 whose cells were free (bits of free_mask) when
+// the block started, in order, re-checking each (a point kept earlier in the block may have
+// covered it). Returns false once `limit` points are kept.
+inline bool keep_free(uint32_t free_mask, const int* cell_of_block, int first, uint8_t* g, int stride, int limit,
+                      int* kept, int& count) {
+  while (free_mask) {
+    const int j = __builtin_ctz(free_mask);
+    free_mask &= free_mask - 1u;
+    uint8_t* cell = g + cell_of_block[j];
+    if (*cell) continue;
+    kept[count++] = first + j;
+    if (count >= limit) return false;
+    mark_cover(cell, stride);
+  }
+  return true;
+}
+
+// Portable scan over blocks of 32: the cells come from per-pass lookup tables (no conversion
+// per candidate), and which candidates find their cell free is computed without branches (most
+// are covered, few kept, so a branch per candidate would be mispredicted at every keep).
+int scan_portable(const SortedCandidates& sorted, const Grid& grid, cv::Size size, uint8_t* g, int limit, int* kept,
+                  Workspace& ws) {
+  int* cx = ws.col_of_x.get(static_cast<std::size_t>(size.width));
+  int* ry = ws.row_of_y.get(static_cast<std::size_t>(size.height));
+  for (int x = 0; x < size.width; ++x) cx[x] = cell_of(static_cast<uint32_t>(x), grid.two_over_w) + 2;
+  for (int y = 0; y < size.height; ++y) ry[y] = (cell_of(static_cast<uint32_t>(y), grid.two_over_w) + 2) * grid.stride;
+  const uint32_t* p = sorted.position;
+  const int n = sorted.size;
+  int count = 0;
+  constexpr int kBlock = 32;
+  int i = 0;
+  for (; i + kBlock <= n; i += kBlock) {
+    std::array<int, kBlock> cells;
+    uint32_t free_mask = 0;
+#pragma GCC unroll 32
+    for (int j = 0; j < kBlock; ++j) {
+      const uint32_t pj = p[i + j];
+      const int c = ry[pj >> 16] + cx[pj & 0xFFFFu];
+      cells[static_cast<std::size_t>(j)] = c;
+      free_mask |= static_cast<uint32_t>(g[c] == 0) << j;
+    }
+    if (!keep_free(free_mask, cells.data(), i, g, grid.stride, limit, kept, count)) return count;
+  }
+  for (; i < n; ++i) {
+    uint8_t* cell = g + ry[p[i] >> 16] + cx[p[i] & 0xFFFFu];
+    if (*cell) continue;
+    kept[count++] = i;
+    if (count >= limit) break;
+    mark_cover(cell, grid.stride);
+  }
+  return count;
+}
+
+#ifdef PLSLAM_SSC_AVX2
+#pragma GCC push_options
+#pragma GCC target("avx2")
+// AVX2 scan: cells of 8 candidates at once by the float formula (no tables to fill per pass),
+// their cover state by one gather.
+int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, int limit, int* kept) {
+  const uint32_t* p = sorted.position;
+  const int n = sorted.size;
+  const __m256i low16 = _mm256_set1_epi32(0xFFFF), two = _mm256_set1_epi32(2), low8 = _mm256_set1_epi32(0xFF);
+  const __m256i stride = _mm256_set1_epi32(grid.stride), zero = _mm256_setzero_si256();
+  const __m256 quarter = _mm256_set1_ps(0.25f), scale = _mm256_set1_ps(grid.two_over_w);
+  int count = 0;
+  constexpr int kBlock = 32;
+  int i = 0;
+  for (; i + kBlock <= n; i += kBlock) {
+    alignas(32) int cells[kBlock];
+    uint32_t free_mask = 0;
+    for (int h = 0; h < kBlock / 8; ++h) {
+      const __m256i pos = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + i + 8 * h));
+      const __m256i x = _mm256_and_si256(pos, low16), y = _mm256_srli_epi32(pos, 16);
+      const __m256i cx = _mm256_cvttps_epi32(_mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(x), quarter), scale));
+      const __m256i cy = _mm256_cvttps_epi32(_mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(y), quarter), scale));
+      const __m256i c = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(cy, two), stride), _mm256_add_epi32(cx, two));
+      _mm256_store_si256(reinterpret_cast<__m256i*>(cells + 8 * h), c);
+      const __m256i state = _mm256_and_si256(_mm256_i32gather_epi32(reinterpret_cast<const int*>(g), c, 1), low8);
+      const auto bits = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(state, zero))));
+      free_mask |= bits << (8 * h);
+    }
+    if (!keep_free(free_mask, cells, i, g, grid.stride, limit, kept, count)) return count;
+  }
+  for (; i < n; ++i) {
+    uint8_t* cell = g + grid.cell(p[i]);
+    if (*cell) continue;
+    kept[count++] = i;
+    if (count >= limit) break;
+    mark_cover(cell, grid.stride);
+  }
+  return count;
+}
+#pragma GCC pop_options
+#endif
+
+bool use_avx2() {
+#ifdef PLSLAM_SSC_AVX2
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has && !detail::ssc_portable_only();
+#else
+  return false;
+#endif
 }
 
 // One greedy covering pass at width w over the sorted candidates. Stops once `limit` points are
@@ -231,77 +382,19 @@ class Coverer {
   Coverer(const SortedCandidates& sorted, cv::Size size, Workspace& ws) : sorted_(sorted), size_(size), ws_(ws) {}
 
   int run(int w, int limit) {
-    // Cells of side c = w/2: the cell of pixel x is floor(2x / w).
-    const int cols = (2 * (size_.width - 1)) / w + 1;
-    const int rows = (2 * (size_.height - 1)) / w + 1;
-    // Two margin cells on each side so covering a 5x5 block needs no bounds checks.
-    const int stride = cols + 4;
-    const std::size_t cells = static_cast<std::size_t>(stride) * static_cast<std::size_t>(rows + 4);
-    uint8_t* g = ws_.grid.get(cells);
-    std::fill_n(g, cells, uint8_t{0});
-    // Pixel -> cell lookups, so that the pass needs no division or float conversion.
-    int* cx = ws_.col_of_x.get(static_cast<std::size_t>(size_.width));
-    int* ry = ws_.row_of_y.get(static_cast<std::size_t>(size_.height));
-    fill_cells(cx, size_.width, w, 1);
-    fill_cells(ry, size_.height, w, stride);
+    const Grid grid(size_, w);
+    uint8_t* g = ws_.grid.get(grid.cells + 4);
+    std::fill_n(g, grid.cells + 4, uint8_t{0});
     kept_ = ws_.kept.get(static_cast<std::size_t>(std::max(limit, 1)));
-    const int n = sorted_.size;
-    const uint32_t* p = sorted_.packed;
-    int* kept = kept_;
-    int count = 0;
-    auto mark = [stride](uint8_t* cell) {
-      for (int dy = -2; dy <= 2; ++dy) {
-        uint8_t* row = cell + dy * stride;
-        row[-2] = row[-1] = row[0] = row[1] = row[2] = 1;
-      }
-    };
-    // Blocks of 32: which candidates find their cell free is computed without branches (most
-    // are covered, few kept, so a branch per candidate is mispredicted at every keep); only those
-    // are then visited in order, re-checked (a point kept earlier in the block may have covered
-    // them), kept and marked.
-    constexpr int kBlock = 32;
-    int i = 0;
-    for (; i + kBlock <= n; i += kBlock) {
-      std::array<int, kBlock> cell_of;
-      uint32_t free_mask = 0;
-#pragma GCC unroll 32
-      for (int j = 0; j < kBlock; ++j) {
-        const uint32_t pj = p[i + j];
-        const int c = ry[pj >> 16] + cx[pj & 0xFFFFu];
-        cell_of[static_cast<std::size_t>(j)] = c;
-        free_mask |= static_cast<uint32_t>(g[c] == 0) << j;
-      }
-      while (free_mask) {
-        const int j = __builtin_ctz(free_mask);
-        free_mask &= free_mask - 1u;
-        uint8_t* cell = g + cell_of[static_cast<std::size_t>(j)];
-        if (*cell) continue;
-        kept[count++] = i + j;
-        if (count >= limit) return count;
-        mark(cell);
-      }
-    }
-    for (; i < n; ++i) {
-      uint8_t* cell = g + ry[p[i] >> 16] + cx[p[i] & 0xFFFFu];
-      if (*cell) continue;
-      kept[count++] = i;
-      if (count >= limit) break;
-      mark(cell);
-    }
-    return count;
+#ifdef PLSLAM_SSC_AVX2
+    if (use_avx2() && grid.cells < (std::size_t{1} << 31)) return scan_avx2(sorted_, grid, g, limit, kept_);
+#endif
+    return scan_portable(sorted_, grid, size_, g, limit, kept_, ws_);
   }
   // Sorted positions of the points kept by the last run.
   const int* kept() const { return kept_; }
 
  private:
-  // table[x] = (floor(2x / w) + 2) * scale for x in [0, n), the division as an exact
-  // multiply-shift: with m = floor(2^40 / w) + 1, floor(2x m / 2^40) = floor(2x / w) because the
-  // error 2x (m - 2^40/w) / 2^40 < 2^17 / 2^40 stays below 1/w for any w < 2^23.
-  static void fill_cells(int* table, int n, int w, int scale) {
-    const uint64_t m = (uint64_t{1} << 40) / static_cast<uint64_t>(w) + 1;
-    for (int x = 0; x < n; ++x) table[x] = (static_cast<int>((static_cast<uint64_t>(2 * x) * m) >> 40) + 2) * scale;
-  }
-
   SortedCandidates sorted_;
   cv::Size size_;
   Workspace& ws_;
@@ -309,6 +402,10 @@ class Coverer {
 };
 
 }  // namespace
+
+namespace detail {
+int ssc_cell(uint32_t x, int w) { return Grid(cv::Size(1, 1), w).cell_of_coordinate(x); }
+}  // namespace detail
 
 SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
                      double tolerance_fraction, double width_hint) {
@@ -356,13 +453,14 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
   };
   const int hint = static_cast<int>(std::lround(width_hint));
   if (hint >= low && hint <= high) {
-    // Gallop from the hint (steps 1, 2, 4, ...) in the direction its outcome points to, until
+    // Gallop from the hint (steps 1, 1, 2, 4, ...) in the direction its outcome points to, until
     // the outcome flips; the bisection then finishes inside the bracket. A hint that is right
     // or off by one costs two or three passes instead of a bisection over the whole range.
     int w = hint;
     done = probe(w);
     const bool wider = low > w;  // feasible at the hint: the widest feasible width is above
-    for (int step = 1; !done && low <= high && (low > w) == wider; step *= 2) {
+    for (int n = 0; !done && low <= high && (low > w) == wider; ++n) {
+      const int step = n < 2 ? 1 : 1 << (n - 1);  // 1, 1, 2, 4, ...: widths drift slowly
       w = wider ? std::min(w + step, high) : std::max(w - step, low);
       done = probe(w);
     }

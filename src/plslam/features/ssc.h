@@ -29,8 +29,8 @@ struct SscResult {
 // overshoots within the tolerance it is returned as is; when the search converges without
 // hitting the tolerance the best overshooting covering is cut to exactly `target` (the first
 // `target` kept points of a greedy pass are themselves a valid covering result).
-// `width_hint` (optional, > 0): a likely width, probed first and then galloped from (steps 1, 2,
-// 4, ... towards the outcome) until the outcome flips, so that a good hint (e.g. the width found
+// `width_hint` (optional, > 0): a likely width, probed first and then galloped from (steps 1, 1,
+// 2, 4, ... towards the outcome) until the outcome flips, so that a good hint (e.g. the width found
 // on the neighbouring pyramid level, where the per-level target follows the level area and the
 // width barely changes) ends the search after two or three passes. The bisection between the
 // closed-form bounds finishes inside the bracket; the result depends on the hint only through
@@ -41,5 +41,24 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
 // Indices of `keypoints` sorted by decreasing response, ties by index (a counting sort when the
 // responses are small integers, as FAST scores are).
 std::vector<int> order_by_response(const std::vector<cv::KeyPoint>& keypoints);
+
+namespace detail {
+// For tests: while alive, ssc_select on this thread uses the portable scan instead of AVX2
+// (the results must be identical).
+class PortableSscScope {
+ public:
+  PortableSscScope();
+  ~PortableSscScope();
+  PortableSscScope(const PortableSscScope&) = delete;
+  PortableSscScope& operator=(const PortableSscScope&) = delete;
+
+ private:
+  bool previous_;
+};
+bool ssc_portable_only();
+// The covering's cell of pixel coordinate x at width w, floor(2x / w), as the scans compute it
+// (float arithmetic, exact for x < 2^21); exposed for an exhaustive test.
+int ssc_cell(uint32_t x, int w);
+}  // namespace detail
 
 }  // namespace plslam::features
