@@ -146,7 +146,8 @@ bool convert_one(const cv::KeyPoint& kp, float x_max, float y_max, uint8_t& bin,
 // Bins and positions of all keypoints (as convert_one), four at a time with SSE2: the 28-byte
 // keypoints are transposed in registers. Returns false when some response is not an integer
 // score.
-bool convert_all(const std::vector<cv::KeyPoint>& keypoints, cv::Size size, uint8_t* bin, uint32_t* pos) {
+bool convert_all(const std::vector<cv::KeyPoint>& keypoints, cv::Size size, uint8_t* bin, uint32_t* pos, int& min_bin,
+                 int& max_bin) {
   const int k = static_cast<int>(keypoints.size());
   const auto x_max = static_cast<float>(size.width - 1), y_max = static_cast<float>(size.height - 1);
   int i = 0;
@@ -159,6 +160,7 @@ bool convert_all(const std::vector<cv::KeyPoint>& keypoints, cv::Size size, uint
   const __m128 r_end = _mm_set1_ps(static_cast<float>(kScoreBins));
   const __m128i top_bin = _mm_set1_epi32(kScoreBins - 1);
   __m128 all_ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  __m128i lo_bin = _mm_set1_epi16(kScoreBins - 1), hi_bin = _mm_setzero_si128();
   auto load = [&](int j, int byte) { return _mm_loadu_ps(reinterpret_cast<const float*>(base + 28 * j + byte)); };
   // The response load of keypoint i+3 reads 12 bytes into keypoint i+4, which must exist.
   for (; i + 5 <= k; i += 4) {
@@ -175,13 +177,23 @@ bool convert_all(const std::vector<cv::KeyPoint>& keypoints, cv::Size size, uint
     all_ok = _mm_and_ps(all_ok, _mm_cmpeq_ps(_mm_cvtepi32_ps(ri), r));
     const __m128i b32 = _mm_sub_epi32(top_bin, ri);
     const __m128i b16 = _mm_packs_epi32(b32, b32);
+    lo_bin = _mm_min_epi16(lo_bin, b16);
+    hi_bin = _mm_max_epi16(hi_bin, b16);
     const int b8 = _mm_cvtsi128_si32(_mm_packus_epi16(b16, b16));
     std::memcpy(bin + i, &b8, 4);
   }
   ok = _mm_movemask_ps(all_ok) == 0xF;
+  alignas(16) std::array<int16_t, 8> lo{}, hi{};
+  _mm_store_si128(reinterpret_cast<__m128i*>(lo.data()), lo_bin);
+  _mm_store_si128(reinterpret_cast<__m128i*>(hi.data()), hi_bin);
+  min_bin = std::min<int>(min_bin, *std::min_element(lo.begin(), lo.end()));
+  max_bin = std::max<int>(max_bin, *std::max_element(hi.begin(), hi.end()));
 #endif
-  for (; i < k; ++i)
+  for (; i < k; ++i) {
     ok &= convert_one(keypoints[static_cast<std::size_t>(i)], x_max, y_max, bin[i], pos[i]);
+    min_bin = std::min<int>(min_bin, bin[i]);
+    max_bin = std::max<int>(max_bin, bin[i]);
+  }
   return ok;
 }
 
@@ -195,7 +207,8 @@ SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv:
   // each) are read once into compact bins and positions; counting and scattering work on those.
   uint8_t* bin = ws.bin.get(n);
   uint32_t* pos = ws.pos.get(n);
-  if (!convert_all(keypoints, size, bin, pos)) {
+  int min_bin = kScoreBins - 1, max_bin = 0;  // the bins in use, for the offsets
+  if (!convert_all(keypoints, size, bin, pos, min_bin, max_bin)) {
     const std::vector<int> order = order_by_response(keypoints);
     for (std::size_t i = 0; i < n; ++i) {
       index[i] = order[i];
@@ -222,7 +235,7 @@ SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv:
   for_each_part([&](int q, int i) { ++next[static_cast<std::size_t>(q)][bin[i]]; });
   // Counts -> first output slot of each (bin, part), bins outermost.
   int offset = 0;
-  for (std::size_t b = 0; b < kScoreBins; ++b)
+  for (auto b = static_cast<std::size_t>(min_bin); b <= static_cast<std::size_t>(max_bin); ++b)
     for (std::size_t q = 0; q < kParts; ++q) {
       const int c = next[q][b];
       next[q][b] = offset;
@@ -245,7 +258,8 @@ inline int cell_of(uint32_t x, float two_over_w) {
 }
 
 // The cover grid of one pass: w/2 cells plus two margin cells on each side, so that covering a
-// 5x5 block needs no bounds checks; 4 spare bytes for 32-bit gathers at the last cell.
+// 5x5 block needs no bounds checks; 8 spare bytes for 32-bit gathers and 8-byte writes at the
+// last cells.
 struct Grid {
   int w, cols, rows, stride;
   float two_over_w;
@@ -263,10 +277,16 @@ struct Grid {
   }
 };
 
+// Covers the 5x5 cells around `cell`: per row one 8-byte read-modify-write (the grid has spare
+// bytes after the last row for it).
 inline void mark_cover(uint8_t* cell, int stride) {
+  constexpr uint64_t kFive = 0x0101010101ull;
   for (int dy = -2; dy <= 2; ++dy) {
-    uint8_t* row = cell + dy * stride;
-    row[-2] = row[-1] = row[0] = row[1] = row[2] = 1;
+    uint8_t* row = cell + dy * stride - 2;
+    uint64_t v;
+    std::memcpy(&v, row, 8);
+    v |= kFive;
+    std::memcpy(row, &v, 8);
   }
 }
 
@@ -383,8 +403,8 @@ class Coverer {
 
   int run(int w, int limit) {
     const Grid grid(size_, w);
-    uint8_t* g = ws_.grid.get(grid.cells + 4);
-    std::fill_n(g, grid.cells + 4, uint8_t{0});
+    uint8_t* g = ws_.grid.get(grid.cells + 8);
+    std::fill_n(g, grid.cells + 8, uint8_t{0});
     kept_ = ws_.kept.get(static_cast<std::size_t>(std::max(limit, 1)));
 #ifdef PLSLAM_SSC_AVX2
     if (use_avx2() && grid.cells < (std::size_t{1} << 31)) return scan_avx2(sorted_, grid, g, limit, kept_);
