@@ -109,9 +109,27 @@ class Scratch {
 // Per-thread buffers (extract() runs the left and right image concurrently), reused by every
 // call on the thread.
 struct Workspace {
-  Scratch<int> index, kept, col_of_x, row_of_y;
+  Scratch<int> index, col_of_x, row_of_y;
+  std::array<Scratch<int>, 2> kept;  // the current pass and the best one so far
   Scratch<uint32_t> pos, position;
-  Scratch<uint8_t> bin, grid;
+  Scratch<uint8_t> bin;
+  // The cover grid of a pass: a cell is covered when it holds the pass's stamp, so that a new
+  // pass needs no clearing (only when the stamps wrap around or the grid grows).
+  Scratch<uint8_t> grid;
+  std::size_t grid_size = 0;
+  uint8_t stamp = 0;
+  uint8_t* grid_for_pass(std::size_t bytes) {
+    if (bytes > grid_size) {
+      grid_size = std::max(bytes, grid_size * 2);
+      std::fill_n(grid.get(grid_size), grid_size, uint8_t{0});
+      stamp = 0;
+    }
+    if (++stamp == 0) {
+      std::fill_n(grid.get(grid_size), grid_size, uint8_t{0});
+      stamp = 1;
+    }
+    return grid.get(grid_size);
+  }
 };
 Workspace& workspace() {
   thread_local Workspace w;
@@ -277,15 +295,16 @@ struct Grid {
   }
 };
 
-// Covers the 5x5 cells around `cell`: per row one 8-byte read-modify-write (the grid has spare
-// bytes after the last row for it).
-inline void mark_cover(uint8_t* cell, int stride) {
-  constexpr uint64_t kFive = 0x0101010101ull;
+// Covers the 5x5 cells around `cell` with `stamp`: per row one 8-byte read-modify-write (the
+// grid has spare bytes after the last row for it).
+inline void mark_cover(uint8_t* cell, int stride, uint8_t stamp) {
+  constexpr uint64_t kFive = 0xFFFFFFFFFFull;
+  const uint64_t stamps = kFive / 0xFF * stamp;
   for (int dy = -2; dy <= 2; ++dy) {
     uint8_t* row = cell + dy * stride - 2;
     uint64_t v;
     std::memcpy(&v, row, 8);
-    v |= kFive;
+    v = (v & ~kFive) | stamps;
     std::memcpy(row, &v, 8);
   }
 }
@@ -293,16 +312,16 @@ inline void mark_cover(uint8_t* cell, int stride) {
 // Keeps the candidates of one block of up to 32 whose cells were free (bits of free_mask) when
 // the block started, in order, re-checking each (a point kept earlier in the block may have
 // covered it). Returns false once `limit` points are kept.
-inline bool keep_free(uint32_t free_mask, const int* cell_of_block, int first, uint8_t* g, int stride, int limit,
-                      int* kept, int& count) {
+inline bool keep_free(uint64_t free_mask, const int* cell_of_block, int first, uint8_t* g, int stride, uint8_t stamp,
+                      int limit, int* kept, int& count) {
   while (free_mask) {
-    const int j = __builtin_ctz(free_mask);
+    const int j = __builtin_ctzll(free_mask);
     free_mask &= free_mask - 1u;
     uint8_t* cell = g + cell_of_block[j];
-    if (*cell) continue;
+    if (*cell == stamp) continue;
     kept[count++] = first + j;
     if (count >= limit) return false;
-    mark_cover(cell, stride);
+    mark_cover(cell, stride, stamp);
   }
   return true;
 }
@@ -310,8 +329,8 @@ inline bool keep_free(uint32_t free_mask, const int* cell_of_block, int first, u
 // Portable scan over blocks of 32: the cells come from per-pass lookup tables (no conversion
 // per candidate), and which candidates find their cell free is computed without branches (most
 // are covered, few kept, so a branch per candidate would be mispredicted at every keep).
-int scan_portable(const SortedCandidates& sorted, const Grid& grid, cv::Size size, uint8_t* g, int limit, int* kept,
-                  Workspace& ws) {
+int scan_portable(const SortedCandidates& sorted, const Grid& grid, cv::Size size, uint8_t* g, uint8_t stamp, int limit,
+                  int* kept, Workspace& ws) {
   int* cx = ws.col_of_x.get(static_cast<std::size_t>(size.width));
   int* ry = ws.row_of_y.get(static_cast<std::size_t>(size.height));
   for (int x = 0; x < size.width; ++x) cx[x] = cell_of(static_cast<uint32_t>(x), grid.two_over_w) + 2;
@@ -329,16 +348,16 @@ int scan_portable(const SortedCandidates& sorted, const Grid& grid, cv::Size siz
       const uint32_t pj = p[i + j];
       const int c = ry[pj >> 16] + cx[pj & 0xFFFFu];
       cells[static_cast<std::size_t>(j)] = c;
-      free_mask |= static_cast<uint32_t>(g[c] == 0) << j;
+      free_mask |= static_cast<uint32_t>(g[c] != stamp) << j;
     }
-    if (!keep_free(free_mask, cells.data(), i, g, grid.stride, limit, kept, count)) return count;
+    if (!keep_free(free_mask, cells.data(), i, g, grid.stride, stamp, limit, kept, count)) return count;
   }
   for (; i < n; ++i) {
     uint8_t* cell = g + ry[p[i] >> 16] + cx[p[i] & 0xFFFFu];
-    if (*cell) continue;
+    if (*cell == stamp) continue;
     kept[count++] = i;
     if (count >= limit) break;
-    mark_cover(cell, grid.stride);
+    mark_cover(cell, grid.stride, stamp);
   }
   return count;
 }
@@ -348,18 +367,18 @@ int scan_portable(const SortedCandidates& sorted, const Grid& grid, cv::Size siz
 #pragma GCC target("avx2")
 // AVX2 scan: cells of 8 candidates at once by the float formula (no tables to fill per pass),
 // their cover state by one gather.
-int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, int limit, int* kept) {
+int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, uint8_t stamp, int limit, int* kept) {
   const uint32_t* p = sorted.position;
   const int n = sorted.size;
   const __m256i low16 = _mm256_set1_epi32(0xFFFF), two = _mm256_set1_epi32(2), low8 = _mm256_set1_epi32(0xFF);
-  const __m256i stride = _mm256_set1_epi32(grid.stride), zero = _mm256_setzero_si256();
+  const __m256i stride = _mm256_set1_epi32(grid.stride), covered = _mm256_set1_epi32(stamp);
   const __m256 quarter = _mm256_set1_ps(0.25f), scale = _mm256_set1_ps(grid.two_over_w);
   int count = 0;
-  constexpr int kBlock = 32;
+  constexpr int kBlock = 64;
   int i = 0;
   for (; i + kBlock <= n; i += kBlock) {
     alignas(32) int cells[kBlock];
-    uint32_t free_mask = 0;
+    uint64_t free_mask = 0;
     for (int h = 0; h < kBlock / 8; ++h) {
       const __m256i pos = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + i + 8 * h));
       const __m256i x = _mm256_and_si256(pos, low16), y = _mm256_srli_epi32(pos, 16);
@@ -368,17 +387,17 @@ int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, int 
       const __m256i c = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(cy, two), stride), _mm256_add_epi32(cx, two));
       _mm256_store_si256(reinterpret_cast<__m256i*>(cells + 8 * h), c);
       const __m256i state = _mm256_and_si256(_mm256_i32gather_epi32(reinterpret_cast<const int*>(g), c, 1), low8);
-      const auto bits = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(state, zero))));
-      free_mask |= bits << (8 * h);
+      const auto bits = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(state, covered))));
+      free_mask |= static_cast<uint64_t>(~bits & 0xFFu) << (8 * h);
     }
-    if (!keep_free(free_mask, cells, i, g, grid.stride, limit, kept, count)) return count;
+    if (!keep_free(free_mask, cells, i, g, grid.stride, stamp, limit, kept, count)) return count;
   }
   for (; i < n; ++i) {
     uint8_t* cell = g + grid.cell(p[i]);
-    if (*cell) continue;
+    if (*cell == stamp) continue;
     kept[count++] = i;
     if (count >= limit) break;
-    mark_cover(cell, grid.stride);
+    mark_cover(cell, grid.stride, stamp);
   }
   return count;
 }
@@ -401,24 +420,21 @@ class Coverer {
  public:
   Coverer(const SortedCandidates& sorted, cv::Size size, Workspace& ws) : sorted_(sorted), size_(size), ws_(ws) {}
 
-  int run(int w, int limit) {
+  // Writes the sorted positions of the kept points to kept (room for `limit`).
+  int run(int w, int limit, int* kept) {
     const Grid grid(size_, w);
-    uint8_t* g = ws_.grid.get(grid.cells + 8);
-    std::fill_n(g, grid.cells + 8, uint8_t{0});
-    kept_ = ws_.kept.get(static_cast<std::size_t>(std::max(limit, 1)));
+    uint8_t* g = ws_.grid_for_pass(grid.cells + 8);
+    const uint8_t stamp = ws_.stamp;
 #ifdef PLSLAM_SSC_AVX2
-    if (use_avx2() && grid.cells < (std::size_t{1} << 31)) return scan_avx2(sorted_, grid, g, limit, kept_);
+    if (use_avx2() && grid.cells < (std::size_t{1} << 31)) return scan_avx2(sorted_, grid, g, stamp, limit, kept);
 #endif
-    return scan_portable(sorted_, grid, size_, g, limit, kept_, ws_);
+    return scan_portable(sorted_, grid, size_, g, stamp, limit, kept, ws_);
   }
-  // Sorted positions of the points kept by the last run.
-  const int* kept() const { return kept_; }
 
  private:
   SortedCandidates sorted_;
   cv::Size size_;
   Workspace& ws_;
-  int* kept_ = nullptr;
 };
 
 }  // namespace
@@ -443,8 +459,12 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
   const SscBounds bounds = ssc_width_bounds(k, target, size);
 
   Coverer cover(sorted, size, ws);
-  std::vector<int> best;
-  best.reserve(static_cast<std::size_t>(target + tolerance + 1));
+  // Passes write into one of two buffers; a pass worth keeping becomes `best` by swapping roles.
+  const auto room = static_cast<std::size_t>(target + tolerance + 1);
+  std::array<int*, 2> buffers{ws.kept[0].get(room), ws.kept[1].get(room)};
+  int current = 0;
+  const int* best = nullptr;
+  int best_count = 0;
   double best_width = 0;
   // Integer widths, as in Bailo et al.: the count changes in steps anyway, and the search
   // ends after about log2(w_high) passes.
@@ -453,11 +473,13 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
   bool done = false;
   // One probe: true when the search is over (count within tolerance).
   auto probe = [&](int w) {
-    const int count = cover.run(w, target + tolerance + 1);
+    const int count = cover.run(w, target + tolerance + 1, buffers[static_cast<std::size_t>(current)]);
     ++result.iterations;
     auto keep_pass = [&] {
-      best.assign(cover.kept(), cover.kept() + count);
+      best = buffers[static_cast<std::size_t>(current)];
+      best_count = count;
       best_width = w;
+      current ^= 1;
     };
     if (std::abs(count - target) <= tolerance) {
       keep_pass();
@@ -486,18 +508,18 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
     }
   }
   while (!done && low <= high) done = probe(low + (high - low) / 2);
-  if (!done && best.empty()) {
+  if (!done && best == nullptr) {
     // Only possible with duplicate positions: fall back to the narrowest cover.
     const int w = std::max(1, static_cast<int>(std::floor(bounds.low)));
     best_width = w;
-    const int count = cover.run(w, target);
-    best.assign(cover.kept(), cover.kept() + count);
+    best = buffers[static_cast<std::size_t>(current)];
+    best_count = cover.run(w, target, buffers[static_cast<std::size_t>(current)]);
     ++result.iterations;
   }
-  if (static_cast<int>(best.size()) > target + tolerance) best.resize(static_cast<std::size_t>(target));
+  if (best_count > target + tolerance) best_count = target;
   result.width = best_width;
-  result.kept.reserve(best.size());
-  for (int pos : best) result.kept.push_back(sorted.index[pos]);
+  result.kept.resize(static_cast<std::size_t>(best_count));
+  for (int i = 0; i < best_count; ++i) result.kept[static_cast<std::size_t>(i)] = sorted.index[best[i]];
   return result;
 }
 
