@@ -230,6 +230,23 @@ TEST(Ssc, RealPyramidCandidatesVectorAndPortableAgreeWithGuarantees) {
   }
 }
 
+TEST(Ssc, ReusedBuffersGiveIdenticalResultsAcrossManyCalls) {
+  // The per-thread cover grid is stamped instead of cleared; the stamps wrap around after 255
+  // passes and the grid grows with the image: neither may change a result.
+  const cv::Size small(200, 150), large(900, 700);
+  const auto a = random_keypoints(3000, small, 41u);
+  const auto b = random_keypoints(20000, large, 42u);
+  const SscResult ref_a = ssc_select(a, 120, small);
+  const SscResult ref_b = ssc_select(b, 700, large);
+  for (int i = 0; i < 150; ++i) {
+    const SscResult ra = ssc_select(a, 120, small);
+    ASSERT_EQ(ra.kept, ref_a.kept) << "call " << i;
+    if (i % 25 == 0) {
+      ASSERT_EQ(ssc_select(b, 700, large).kept, ref_b.kept) << "call " << i;
+    }
+  }
+}
+
 TEST(Ssc, OrderByResponseIsStableDescending) {
   std::vector<cv::KeyPoint> kps;
   for (float r : {3.f, 9.f, 3.f, 250.f, 0.f, 9.f}) kps.emplace_back(cv::Point2f(0, 0), 1.f, -1.f, r);
