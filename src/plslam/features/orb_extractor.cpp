@@ -149,10 +149,11 @@ std::vector<int> OrbExtractor::level_targets(const PyramidCandidates& candidates
 PyramidCandidates OrbExtractor::distribute(const PyramidCandidates& candidates, Distribution method) const {
   const std::vector<int> targets = level_targets(candidates);
   PyramidCandidates out(candidates.size());
-  // From the smallest level up: its search is cheap, and its width is a good first guess for the
-  // next level (the per-level target follows the area, so the width in level pixels barely
-  // changes).
-  double width_hint = 0;
+  // From the smallest level up: its search is cheap, and the widths found are a good first guess
+  // for the next level (the per-level target follows the area, so the width in level pixels
+  // barely changes). The guess is the mean of the last two widths (halves up), which needs fewer
+  // passes than the last width alone over KITTI 06 and EuRoC V1_01 frames.
+  double width_hint = 0, last_width = 0;
   for (std::size_t r = 0; r < candidates.size(); ++r) {
     const std::size_t l = candidates.size() - 1 - r;
     const auto& lc = candidates[l];
@@ -166,7 +167,10 @@ PyramidCandidates OrbExtractor::distribute(const PyramidCandidates& candidates, 
     std::vector<int> kept;
     if (method == Distribution::kSsc) {
       SscResult res = ssc_select(lc.keypoints, targets[l], lc.region, options_.ssc_tolerance, width_hint);
-      if (res.width > 0) width_hint = res.width;
+      if (res.width > 0) {
+        width_hint = last_width > 0 ? std::floor(0.5 * (res.width + last_width) + 0.5) : res.width;
+        last_width = res.width;
+      }
       kept = std::move(res.kept);
     } else {
       kept = quadtree_select(lc.keypoints, targets[l], lc.region);
