@@ -61,13 +61,19 @@ void BM_Pyramid(benchmark::State& st) {
   }
 }
 
-void BM_Fast(benchmark::State& st) {
+void fast(benchmark::State& st, features::FastImpl impl) {
   REQUIRE_SCENE(st, s);
-  const features::OrbExtractor ex(s->orb);
+  features::OrbOptions o = s->orb;
+  o.fast_impl = impl;
+  const features::OrbExtractor ex(o);
   features::ImagePyramid p;
   ex.build_pyramid(s->frame.left, p);
   for (auto _ : st) benchmark::DoNotOptimize(ex.detect(p));
 }
+// Own SIMD FAST (AVX2 when the CPU has it) against cv::FAST, same corners.
+void BM_Fast(benchmark::State& st) { fast(st, features::FastImpl::kAuto); }
+void BM_FastSse2(benchmark::State& st) { fast(st, features::FastImpl::kSse2); }
+void BM_FastOpenCv(benchmark::State& st) { fast(st, features::FastImpl::kOpenCv); }
 
 void distribution(benchmark::State& st, features::Distribution method) {
   REQUIRE_SCENE(st, s);
@@ -92,11 +98,15 @@ void BM_OrientationAndBrief(benchmark::State& st) {
   }
 }
 
-void BM_LeftImage(benchmark::State& st) {
+void left_image(benchmark::State& st, features::FastImpl impl) {
   REQUIRE_SCENE(st, s);
-  const features::OrbExtractor ex(s->orb);
+  features::OrbOptions o = s->orb;
+  o.fast_impl = impl;
+  const features::OrbExtractor ex(o);
   for (auto _ : st) benchmark::DoNotOptimize(ex.extract(s->frame.left));
 }
+void BM_LeftImage(benchmark::State& st) { left_image(st, features::FastImpl::kAuto); }
+void BM_LeftImageOpenCvFast(benchmark::State& st) { left_image(st, features::FastImpl::kOpenCv); }
 
 void BM_StereoMatching(benchmark::State& st) {
   REQUIRE_SCENE(st, s);
@@ -127,10 +137,13 @@ void BM_StereoFrameParallel(benchmark::State& st) {
 #define SCENES ->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true)
 BENCHMARK(BM_Pyramid) SCENES;
 BENCHMARK(BM_Fast) SCENES;
+BENCHMARK(BM_FastSse2) SCENES;
+BENCHMARK(BM_FastOpenCv) SCENES;
 BENCHMARK(BM_Ssc) SCENES;
 BENCHMARK(BM_Quadtree) SCENES;
 BENCHMARK(BM_OrientationAndBrief) SCENES;
 BENCHMARK(BM_LeftImage) SCENES;
+BENCHMARK(BM_LeftImageOpenCvFast) SCENES;
 BENCHMARK(BM_StereoMatching) SCENES;
 BENCHMARK(BM_StereoFrameParallel) SCENES->UseRealTime();
 

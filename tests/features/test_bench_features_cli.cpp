@@ -24,6 +24,17 @@ TEST(BenchFeaturesCli, JsonHasEveryStageOnKitti) {
   EXPECT_GT(j["keypoints"]["fast_candidates"]["median"].get<double>(), 2000.0);
   EXPECT_GT(j["stereo_matches"]["share"]["median"].get<double>(), 0.5);
   EXPECT_GT(j["uniformity_cv"]["quadtree"]["median"].get<double>(), 0.0);
+  EXPECT_NE(j["config"]["fast_impl"].get<std::string>(), "auto");  // resolved to what ran
+
+  // cv::FAST stays selectable for comparisons and finds the very same corners.
+  const auto r_cv = test::run_cli("bench features '" + (data / "kitti/sequences/06").string() +
+                                  "' --frames 2 --json --fast-impl opencv");
+  ASSERT_EQ(r_cv.exit_code, 0) << r_cv.err;
+  const auto j_cv = nlohmann::json::parse(r_cv.out);
+  EXPECT_EQ(j_cv["config"]["fast_impl"].get<std::string>(), "opencv");
+  EXPECT_EQ(j_cv["keypoints"]["fast_candidates"], j["keypoints"]["fast_candidates"]);
+  EXPECT_EQ(j_cv["uniformity_cv"], j["uniformity_cv"]);
+  EXPECT_EQ(j_cv["stereo_matches"]["median"], j["stereo_matches"]["median"]);
 }
 
 TEST(BenchFeaturesCli, HumanOutputAndBadInput) {
@@ -35,6 +46,7 @@ TEST(BenchFeaturesCli, HumanOutputAndBadInput) {
   const auto missing = test::run_cli("bench features /nonexistent/sequence --json");
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_TRUE(missing.out.empty());
+  EXPECT_EQ(test::run_cli("bench features '" + (data / "euroc/V1_01_easy_micro").string() + "' --fast-impl neon").exit_code, 2);
   EXPECT_EQ(test::run_cli("bench").exit_code, 2);  // a subcommand is required
 }
 

@@ -8,7 +8,10 @@
 #include <gtest/gtest.h>
 
 #include "plslam/features/keypoint_uniformity.h"
+#include "plslam/features/orb_extractor.h"
 #include "plslam/features/ssc.h"
+#include "plslam/io/dataset.h"
+#include "support/test_support.h"
 
 namespace plslam::features {
 namespace {
@@ -165,6 +168,83 @@ TEST(Ssc, LowerBoundKeepsEnoughPointsOnDensestInput) {
   const SscResult r = ssc_select(kps, target, size);
   EXPECT_EQ(static_cast<int>(r.kept.size()), target);
   EXPECT_GE(r.width, std::floor(b.low));
+}
+
+TEST(Ssc, FloatCellFormulaIsExactIntegerDivision) {
+  // floor(2x / w) for every coordinate a level can have and widths far beyond any search.
+  std::vector<int> widths;
+  for (int w = 1; w <= 300; ++w) widths.push_back(w);
+  for (int w : {511, 512, 1000, 4097, 32768, 65535, 65536}) widths.push_back(w);
+  for (int w : widths) {
+    int bad = 0;
+    for (uint32_t x = 0; x < 65536; ++x) bad += detail::ssc_cell(x, w) != static_cast<int>(2 * x / static_cast<uint32_t>(w));
+    ASSERT_EQ(bad, 0) << "w = " << w;
+  }
+}
+
+TEST(Ssc, VectorAndPortableScansAgree) {
+  // The AVX2 scan (when the CPU has it) and the portable one keep the same points; integer and
+  // non-integer responses, several sizes, targets and hints.
+  for (const bool integer_scores : {true, false}) {
+    for (const cv::Size size : {cv::Size(752, 480), cv::Size(97, 61)}) {
+      auto kps = random_keypoints(size.area() / 20, size, 31u + static_cast<uint32_t>(size.width), true);
+      if (!integer_scores)
+        for (auto& k : kps) k.response += 0.5f;
+      for (const int target : {7, 40, 333}) {
+        for (const double hint : {0.0, 9.0}) {
+          const SscResult fast = ssc_select(kps, target, size, 0.001, hint);
+          SscResult portable;
+          {
+            const detail::PortableSscScope scope;
+            portable = ssc_select(kps, target, size, 0.001, hint);
+          }
+          EXPECT_EQ(fast.kept, portable.kept) << size << " target " << target;
+          EXPECT_EQ(fast.width, portable.width);
+          EXPECT_EQ(fast.iterations, portable.iterations);
+        }
+      }
+    }
+  }
+}
+
+TEST(Ssc, RealPyramidCandidatesVectorAndPortableAgreeWithGuarantees) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  for (const char* seq : {"kitti/sequences/06", "euroc/V1_01_easy_micro"}) {
+    const auto ds = io::open_dataset(data / seq);
+    const OrbExtractor ex(std::string(seq).find("kitti") != std::string::npos ? OrbOptions::kitti() : OrbOptions::euroc());
+    ImagePyramid p;
+    ex.build_pyramid(ds->load(0).left, p);
+    const PyramidCandidates cand = ex.detect(p);
+    const std::vector<int> targets = ex.level_targets(cand);
+    for (std::size_t l = 0; l < cand.size(); ++l) {
+      const SscResult fast = ssc_select(cand[l].keypoints, targets[l], cand[l].region, 0.001, 11.0);
+      SscResult portable;
+      {
+        const detail::PortableSscScope scope;
+        portable = ssc_select(cand[l].keypoints, targets[l], cand[l].region, 0.001, 11.0);
+      }
+      EXPECT_EQ(fast.kept, portable.kept) << seq << " level " << l;
+      EXPECT_EQ(static_cast<int>(fast.kept.size()), targets[l]);
+      EXPECT_GT(min_max_norm_distance(cand[l].keypoints, fast.kept), fast.width);
+    }
+  }
+}
+
+TEST(Ssc, ReusedBuffersGiveIdenticalResultsAcrossManyCalls) {
+  // The per-thread cover grid is stamped instead of cleared; the stamps wrap around after 255
+  // passes and the grid grows with the image: neither may change a result.
+  const cv::Size small(200, 150), large(900, 700);
+  const auto a = random_keypoints(3000, small, 41u);
+  const auto b = random_keypoints(20000, large, 42u);
+  const SscResult ref_a = ssc_select(a, 120, small);
+  const SscResult ref_b = ssc_select(b, 700, large);
+  for (int i = 0; i < 150; ++i) {
+    const SscResult ra = ssc_select(a, 120, small);
+    ASSERT_EQ(ra.kept, ref_a.kept) << "call " << i;
+    if (i % 25 == 0) {
+      ASSERT_EQ(ssc_select(b, 700, large).kept, ref_b.kept) << "call " << i;
+    }
+  }
 }
 
 TEST(Ssc, OrderByResponseIsStableDescending) {

@@ -22,6 +22,7 @@ struct BenchFeaturesArgs {
   int n_features = 0;
   int fast_threshold = 7;
   std::string fast_mode = "single";
+  std::string fast_impl = "auto";
   double right_factor = 2.0;
 };
 
@@ -54,6 +55,9 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   o.n_features = args.n_features;
   o.orb.fast_mode = features::parse_fast_mode(args.fast_mode);
   o.orb.fast_threshold = args.fast_threshold;
+  o.orb.fast_impl = features::parse_fast_impl(args.fast_impl);
+  if (!features::fast_impl_available(o.orb.fast_impl))
+    throw InputError("", std::string("--fast-impl ") + args.fast_impl + " is not available on this CPU");
   o.right_feature_factor = args.right_factor;
   if (!(o.right_feature_factor >= 1.0)) throw InputError("", "--right-factor must be >= 1");
   nlohmann::json j = features::run_point_benchmark(*ds, o);
@@ -67,9 +71,10 @@ int run_bench_features(const BenchFeaturesArgs& args) {
     std::cout << j.dump(2) << "\n";
     return 0;
   }
-  std::cout << fmt::format("{} ({}), {} frames, {}x{}, {} features, one thread\n", j["dataset"].get<std::string>(),
+  std::cout << fmt::format("{} ({}), {} frames, {}x{}, {} features, FAST {}, one thread\n", j["dataset"].get<std::string>(),
                            j["format"].get<std::string>(), j["frames"].get<int>(), j["width"].get<int>(),
-                           j["height"].get<int>(), j["config"]["n_features"].get<int>())
+                           j["height"].get<int>(), j["config"]["n_features"].get<int>(),
+                           j["config"]["fast_impl"].get<std::string>())
             << "points, left image:\n"
             << stage_line(j, "pyramid_ms", "pyramid") << stage_line(j, "fast_ms", "FAST")
             << stage_line(j, "ssc_ms", "SSC") << stage_line(j, "quadtree_ms", "quadtree (same input)")
@@ -115,6 +120,8 @@ CommandRegistration reg({"bench", "Benchmark front-end stages on real frames", [
                                ->check(CLI::Range(1, 254))->capture_default_str();
                            features->add_option("--fast-mode", args->fast_mode, "single | ini_min (20/7 per cell)")
                                ->check(CLI::IsMember({"single", "ini_min"}))->capture_default_str();
+                           features->add_option("--fast-impl", args->fast_impl, "FAST code: auto | avx2 | sse2 | scalar | opencv (same corners)")
+                               ->check(CLI::IsMember({"auto", "avx2", "sse2", "scalar", "opencv"}))->capture_default_str();
                            features->add_option("--right-factor", args->right_factor, "Right image keeps this many times more points")
                                ->capture_default_str();
                            return std::function<int()>([args, features] {

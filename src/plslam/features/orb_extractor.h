@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "plslam/features/fast_detector.h"
 #include "plslam/features/image_pyramid.h"
 
 namespace plslam::features {
@@ -31,6 +32,7 @@ struct OrbOptions {
   int fast_threshold = 7;       // kSingle
   int fast_ini_threshold = 20;  // kIniMin
   int fast_min_threshold = 7;   // kIniMin
+  FastImpl fast_impl = FastImpl::kAuto;  // same corners whichever; kOpenCv for comparisons
   Distribution distribution = Distribution::kSsc;
   double ssc_tolerance = 0.001;  // fraction of the per-level target (the paper's 0.001 N)
   int edge_margin = 16;          // keypoints stay this far inside each level (pixels of that level)

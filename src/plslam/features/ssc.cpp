@@ -2,9 +2,21 @@
 
 #include <algorithm>
 #include <array>
-#include <stdexcept>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <memory>
 #include <numeric>
+#include <stdexcept>
+
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define PLSLAM_SSC_AVX2 1
+#endif
 
 namespace plslam::features {
 
@@ -66,111 +78,368 @@ std::vector<int> order_by_response(const std::vector<cv::KeyPoint>& keypoints) {
   return order;
 }
 
+namespace detail {
 namespace {
+thread_local bool portable_only = false;
+}
+bool ssc_portable_only() { return portable_only; }
+PortableSscScope::PortableSscScope() : previous_(portable_only) { portable_only = true; }
+PortableSscScope::~PortableSscScope() { portable_only = previous_; }
+}  // namespace detail
+
+namespace {
+
+// An uninitialised buffer that only grows: no allocation or zero-fill per call.
+template <class T>
+class Scratch {
+ public:
+  T* get(std::size_t n) {
+    if (n > size_) {
+      data_ = std::make_unique_for_overwrite<T[]>(n);
+      size_ = n;
+    }
+    return data_.get();
+  }
+
+ private:
+  std::unique_ptr<T[]> data_;
+  std::size_t size_ = 0;
+};
+
+// Per-thread buffers (extract() runs the left and right image concurrently), reused by every
+// call on the thread.
+struct Workspace {
+  Scratch<int> index, col_of_x, row_of_y;
+  std::array<Scratch<int>, 2> kept;  // the current pass and the best one so far
+  Scratch<uint32_t> pos, position;
+  Scratch<uint8_t> bin;
+  // The cover grid of a pass: a cell is covered when it holds the pass's stamp, so that a new
+  // pass needs no clearing (only when the stamps wrap around or the grid grows).
+  Scratch<uint8_t> grid;
+  std::size_t grid_size = 0;
+  uint8_t stamp = 0;
+  uint8_t* grid_for_pass(std::size_t bytes) {
+    if (bytes > grid_size) {
+      grid_size = std::max(bytes, grid_size * 2);
+      std::fill_n(grid.get(grid_size), grid_size, uint8_t{0});
+      stamp = 0;
+    }
+    if (++stamp == 0) {
+      std::fill_n(grid.get(grid_size), grid_size, uint8_t{0});
+      stamp = 1;
+    }
+    return grid.get(grid_size);
+  }
+};
+Workspace& workspace() {
+  thread_local Workspace w;
+  return w;
+}
 
 // Candidates in visiting order (strongest first): original index and integer pixel position
 // packed as y << 16 | x. The covering works on whole pixels (FAST corners are whole pixels).
 struct SortedCandidates {
-  std::vector<int> index;
-  std::vector<uint32_t> packed;
+  const int* index;
+  const uint32_t* position;
+  int size;
 };
 
-SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv::Size size) {
+constexpr int kScoreBins = 256;  // FAST scores are below 256
+
+// Reads keypoint i into its score bin (255 - score: strongest first) and packed position,
+// clamped into the image. Returns false when the response is not an integer in [0, 256).
+bool convert_one(const cv::KeyPoint& kp, float x_max, float y_max, uint8_t& bin, uint32_t& pos) {
+  // Clamped as floats, NaN to 0, so the integer conversions are always defined.
+  const float x = std::min(kp.pt.x > 0.f ? kp.pt.x : 0.f, x_max);
+  const float y = std::min(kp.pt.y > 0.f ? kp.pt.y : 0.f, y_max);
+  pos = static_cast<uint32_t>(y) << 16 | static_cast<uint32_t>(x);
+  const float r = kp.response;
+  const float in_range = (r >= 0.f && r < static_cast<float>(kScoreBins)) ? r : 0.f;  // false for NaN too
+  const int ri = static_cast<int>(in_range);
+  bin = static_cast<uint8_t>(kScoreBins - 1 - ri);
+  // Integer test by conversion: std::floor is a library call without SSE4.1.
+  return static_cast<float>(ri) == r;
+}
+
+// Bins and positions of all keypoints (as convert_one), four at a time with SSE2: the 28-byte
+// keypoints are transposed in registers. Returns false when some response is not an integer
+// score.
+bool convert_all(const std::vector<cv::KeyPoint>& keypoints, cv::Size size, uint8_t* bin, uint32_t* pos, int& min_bin,
+                 int& max_bin) {
   const int k = static_cast<int>(keypoints.size());
-  SortedCandidates s;
-  s.index.resize(static_cast<std::size_t>(k));
-  s.packed.resize(static_cast<std::size_t>(k));
-  auto pack = [&](const cv::KeyPoint& kp) {
-    const auto x = static_cast<uint32_t>(std::clamp(static_cast<int>(kp.pt.x), 0, size.width - 1));
-    const auto y = static_cast<uint32_t>(std::clamp(static_cast<int>(kp.pt.y), 0, size.height - 1));
-    return y << 16 | x;
-  };
-  // Counting sort on integer scores (FAST's), descending and stable, in two sequential passes.
-  constexpr int kBins = 256;  // FAST scores are below 256
-  std::array<int, kBins + 1> start{};
-  bool integer_scores = true;
-  for (const auto& kp : keypoints) {
-    const float r = kp.response;
-    // Integer test by conversion: std::floor is a library call without SSE4.1.
-    if (!(r >= 0.f && r < kBins && static_cast<float>(static_cast<int>(r)) == r)) {
-      integer_scores = false;
-      break;
-    }
-    ++start[static_cast<std::size_t>(kBins - static_cast<int>(r))];
+  const auto x_max = static_cast<float>(size.width - 1), y_max = static_cast<float>(size.height - 1);
+  int i = 0;
+  bool ok = true;
+#ifdef __SSE2__
+  static_assert(sizeof(cv::KeyPoint) == 28 && offsetof(cv::KeyPoint, pt) == 0 && offsetof(cv::KeyPoint, response) == 16,
+                "cv::KeyPoint layout");
+  const char* base = reinterpret_cast<const char*>(keypoints.data());
+  const __m128 zero = _mm_setzero_ps(), vx_max = _mm_set1_ps(x_max), vy_max = _mm_set1_ps(y_max);
+  const __m128 r_end = _mm_set1_ps(static_cast<float>(kScoreBins));
+  const __m128i top_bin = _mm_set1_epi32(kScoreBins - 1);
+  __m128 all_ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  __m128i lo_bin = _mm_set1_epi16(kScoreBins - 1), hi_bin = _mm_setzero_si128();
+  auto load = [&](int j, int byte) { return _mm_loadu_ps(reinterpret_cast<const float*>(base + 28 * j + byte)); };
+  // The response load of keypoint i+3 reads 12 bytes into keypoint i+4, which must exist.
+  for (; i + 5 <= k; i += 4) {
+    const __m128 xy01 = _mm_unpacklo_ps(load(i, 0), load(i + 1, 0));      // x0 x1 y0 y1
+    const __m128 xy23 = _mm_unpacklo_ps(load(i + 2, 0), load(i + 3, 0));  // x2 x3 y2 y3
+    const __m128 x = _mm_movelh_ps(xy01, xy23), y = _mm_movehl_ps(xy23, xy01);
+    const __m128 r = _mm_movelh_ps(_mm_unpacklo_ps(load(i, 16), load(i + 1, 16)), _mm_unpacklo_ps(load(i + 2, 16), load(i + 3, 16)));
+    // max_ps returns its second operand when the first is NaN, like `v > 0 ? v : 0`.
+    const __m128i xi = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, zero), vx_max));
+    const __m128i yi = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(y, zero), vy_max));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(pos + i), _mm_or_si128(_mm_slli_epi32(yi, 16), xi));
+    const __m128 in_range = _mm_and_ps(_mm_cmpge_ps(r, zero), _mm_cmplt_ps(r, r_end));
+    const __m128i ri = _mm_cvttps_epi32(_mm_and_ps(in_range, r));
+    all_ok = _mm_and_ps(all_ok, _mm_cmpeq_ps(_mm_cvtepi32_ps(ri), r));
+    const __m128i b32 = _mm_sub_epi32(top_bin, ri);
+    const __m128i b16 = _mm_packs_epi32(b32, b32);
+    lo_bin = _mm_min_epi16(lo_bin, b16);
+    hi_bin = _mm_max_epi16(hi_bin, b16);
+    const int b8 = _mm_cvtsi128_si32(_mm_packus_epi16(b16, b16));
+    std::memcpy(bin + i, &b8, 4);
   }
-  if (integer_scores) {
-    for (int i = 0; i < kBins; ++i) start[static_cast<std::size_t>(i) + 1] += start[static_cast<std::size_t>(i)];
-    for (int i = 0; i < k; ++i) {
-      const auto& kp = keypoints[static_cast<std::size_t>(i)];
-      const auto pos = static_cast<std::size_t>(start[static_cast<std::size_t>(kBins - 1 - static_cast<int>(kp.response))]++);
-      s.index[pos] = i;
-      s.packed[pos] = pack(kp);
+  ok = _mm_movemask_ps(all_ok) == 0xF;
+  alignas(16) std::array<int16_t, 8> lo{}, hi{};
+  _mm_store_si128(reinterpret_cast<__m128i*>(lo.data()), lo_bin);
+  _mm_store_si128(reinterpret_cast<__m128i*>(hi.data()), hi_bin);
+  min_bin = std::min<int>(min_bin, *std::min_element(lo.begin(), lo.end()));
+  max_bin = std::max<int>(max_bin, *std::max_element(hi.begin(), hi.end()));
+#endif
+  for (; i < k; ++i) {
+    ok &= convert_one(keypoints[static_cast<std::size_t>(i)], x_max, y_max, bin[i], pos[i]);
+    min_bin = std::min<int>(min_bin, bin[i]);
+    max_bin = std::max<int>(max_bin, bin[i]);
+  }
+  return ok;
+}
+
+SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv::Size size, Workspace& ws) {
+  const int k = static_cast<int>(keypoints.size());
+  const auto n = static_cast<std::size_t>(k);
+  int* index = ws.index.get(n);
+  uint32_t* position = ws.position.get(n);
+  const SortedCandidates s{index, position, k};
+  // Counting sort on integer scores (FAST's), descending and stable. The keypoints (28 bytes
+  // each) are read once into compact bins and positions; counting and scattering work on those.
+  uint8_t* bin = ws.bin.get(n);
+  uint32_t* pos = ws.pos.get(n);
+  int min_bin = kScoreBins - 1, max_bin = 0;  // the bins in use, for the offsets
+  if (!convert_all(keypoints, size, bin, pos, min_bin, max_bin)) {
+    const std::vector<int> order = order_by_response(keypoints);
+    for (std::size_t i = 0; i < n; ++i) {
+      index[i] = order[i];
+      position[i] = pos[order[i]];
     }
     return s;
   }
-  s.index = order_by_response(keypoints);
-  for (int i = 0; i < k; ++i) s.packed[static_cast<std::size_t>(i)] = pack(keypoints[static_cast<std::size_t>(s.index[static_cast<std::size_t>(i)])]);
+  // FAST scores crowd into a few bins, so one counter per bin would chain every increment
+  // through the same memory word; instead the input is split into four consecutive parts with
+  // their own counters (four independent chains). Stability holds because part q's run of a
+  // bin is placed after the runs of parts 0..q-1.
+  constexpr int kParts = 4;
+  std::array<std::array<int, kScoreBins>, kParts> next{};
+  std::array<int, kParts + 1> part_begin{};
+  for (int q = 0; q <= kParts; ++q) part_begin[static_cast<std::size_t>(q)] = static_cast<int>(static_cast<int64_t>(k) * q / kParts);
+  const int common = k / kParts;  // every part has at least this many
+  // Runs f(q, i) over all parts, interleaved.
+  auto for_each_part = [&](auto&& f) {
+    for (int j = 0; j < common; ++j)
+      for (int q = 0; q < kParts; ++q) f(q, part_begin[static_cast<std::size_t>(q)] + j);
+    for (int q = 0; q < kParts; ++q)
+      for (int i = part_begin[static_cast<std::size_t>(q)] + common; i < part_begin[static_cast<std::size_t>(q) + 1]; ++i) f(q, i);
+  };
+  for_each_part([&](int q, int i) { ++next[static_cast<std::size_t>(q)][bin[i]]; });
+  // Counts -> first output slot of each (bin, part), bins outermost.
+  int offset = 0;
+  for (auto b = static_cast<std::size_t>(min_bin); b <= static_cast<std::size_t>(max_bin); ++b)
+    for (std::size_t q = 0; q < kParts; ++q) {
+      const int c = next[q][b];
+      next[q][b] = offset;
+      offset += c;
+    }
+  for_each_part([&](int q, int i) {
+    const int dst = next[static_cast<std::size_t>(q)][bin[i]]++;
+    index[dst] = i;
+    position[dst] = pos[i];
+  });
   return s;
 }
 
+// The cell of pixel coordinate x at width w is floor(2x / w) (cells of side w/2), computed as
+// trunc((x + 1/4) * fl(2/w)) in float arithmetic, which SIMD code can do for many candidates at
+// once. Exact for x < 2^21: the true value (2x + 1/2)/w lies at least 1/(2w) away from an
+// integer, while the two float roundings move it by at most 2^-23 (2x + 1/2)/w, less than that.
+inline int cell_of(uint32_t x, float two_over_w) {
+  return static_cast<int>((static_cast<float>(x) + 0.25f) * two_over_w);
+}
+
+// The cover grid of one pass: w/2 cells plus two margin cells on each side, so that covering a
+// 5x5 block needs no bounds checks; 8 spare bytes for 32-bit gathers and 8-byte writes at the
+// last cells.
+struct Grid {
+  int w, cols, rows, stride;
+  float two_over_w;
+  std::size_t cells;
+  Grid(cv::Size size, int width)
+      : w(width),
+        cols((2 * (size.width - 1)) / width + 1),
+        rows((2 * (size.height - 1)) / width + 1),
+        stride(cols + 4),
+        two_over_w(2.0f / static_cast<float>(width)),
+        cells(static_cast<std::size_t>(stride) * static_cast<std::size_t>(rows + 4)) {}
+  int cell_of_coordinate(uint32_t x) const { return cell_of(x, two_over_w); }
+  int cell(uint32_t packed) const {
+    return (cell_of(packed >> 16, two_over_w) + 2) * stride + cell_of(packed & 0xFFFFu, two_over_w) + 2;
+  }
+};
+
+// Covers the 5x5 cells around `cell` with `stamp`: per row a 4-byte and a 1-byte store. Plain
+// stores, no read-modify-write: a wider load overlapping an earlier store at another offset
+// cannot be forwarded and stalls (measured 2x slower keeps).
+inline void mark_cover(uint8_t* cell, int stride, uint8_t stamp) {
+  const uint32_t four = 0x01010101u * stamp;
+  for (int dy = -2; dy <= 2; ++dy) {
+    uint8_t* row = cell + dy * stride - 2;
+    std::memcpy(row, &four, 4);
+    row[4] = stamp;
+  }
+}
+
+// Keeps the candidates of one block of up to 32 whose cells were free (bits of free_mask) when
+// the block started, in order, re-checking each (a point kept earlier in the block may have
+// covered it). Returns false once `limit` points are kept.
+inline bool keep_free(uint64_t free_mask, const int* cell_of_block, int first, uint8_t* g, int stride, uint8_t stamp,
+                      int limit, int* kept, int& count) {
+  while (free_mask) {
+    const int j = __builtin_ctzll(free_mask);
+    free_mask &= free_mask - 1u;
+    uint8_t* cell = g + cell_of_block[j];
+    if (*cell == stamp) continue;
+    kept[count++] = first + j;
+    if (count >= limit) return false;
+    mark_cover(cell, stride, stamp);
+  }
+  return true;
+}
+
+// Portable scan over blocks of 32: the cells come from per-pass lookup tables (no conversion
+// per candidate), and which candidates find their cell free is computed without branches (most
+// are covered, few kept, so a branch per candidate would be mispredicted at every keep).
+int scan_portable(const SortedCandidates& sorted, const Grid& grid, cv::Size size, uint8_t* g, uint8_t stamp, int limit,
+                  int* kept, Workspace& ws) {
+  int* cx = ws.col_of_x.get(static_cast<std::size_t>(size.width));
+  int* ry = ws.row_of_y.get(static_cast<std::size_t>(size.height));
+  for (int x = 0; x < size.width; ++x) cx[x] = cell_of(static_cast<uint32_t>(x), grid.two_over_w) + 2;
+  for (int y = 0; y < size.height; ++y) ry[y] = (cell_of(static_cast<uint32_t>(y), grid.two_over_w) + 2) * grid.stride;
+  const uint32_t* p = sorted.position;
+  const int n = sorted.size;
+  int count = 0;
+  constexpr int kBlock = 32;
+  int i = 0;
+  for (; i + kBlock <= n; i += kBlock) {
+    std::array<int, kBlock> cells;
+    uint32_t free_mask = 0;
+#pragma GCC unroll 32
+    for (int j = 0; j < kBlock; ++j) {
+      const uint32_t pj = p[i + j];
+      const int c = ry[pj >> 16] + cx[pj & 0xFFFFu];
+      cells[static_cast<std::size_t>(j)] = c;
+      free_mask |= static_cast<uint32_t>(g[c] != stamp) << j;
+    }
+    if (!keep_free(free_mask, cells.data(), i, g, grid.stride, stamp, limit, kept, count)) return count;
+  }
+  for (; i < n; ++i) {
+    uint8_t* cell = g + ry[p[i] >> 16] + cx[p[i] & 0xFFFFu];
+    if (*cell == stamp) continue;
+    kept[count++] = i;
+    if (count >= limit) break;
+    mark_cover(cell, grid.stride, stamp);
+  }
+  return count;
+}
+
+#ifdef PLSLAM_SSC_AVX2
+#pragma GCC push_options
+#pragma GCC target("avx2")
+// AVX2 scan: cells of 8 candidates at once by the float formula (no tables to fill per pass),
+// their cover state by one gather.
+int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, uint8_t stamp, int limit, int* kept) {
+  const uint32_t* p = sorted.position;
+  const int n = sorted.size;
+  const __m256i low16 = _mm256_set1_epi32(0xFFFF), two = _mm256_set1_epi32(2), low8 = _mm256_set1_epi32(0xFF);
+  const __m256i stride = _mm256_set1_epi32(grid.stride), covered = _mm256_set1_epi32(stamp);
+  const __m256 quarter = _mm256_set1_ps(0.25f), scale = _mm256_set1_ps(grid.two_over_w);
+  int count = 0;
+  constexpr int kBlock = 64;
+  int i = 0;
+  for (; i + kBlock <= n; i += kBlock) {
+    alignas(32) int cells[kBlock];
+    uint64_t free_mask = 0;
+    for (int h = 0; h < kBlock / 8; ++h) {
+      const __m256i pos = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + i + 8 * h));
+      const __m256i x = _mm256_and_si256(pos, low16), y = _mm256_srli_epi32(pos, 16);
+      const __m256i cx = _mm256_cvttps_epi32(_mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(x), quarter), scale));
+      const __m256i cy = _mm256_cvttps_epi32(_mm256_mul_ps(_mm256_add_ps(_mm256_cvtepi32_ps(y), quarter), scale));
+      const __m256i c = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_add_epi32(cy, two), stride), _mm256_add_epi32(cx, two));
+      _mm256_store_si256(reinterpret_cast<__m256i*>(cells + 8 * h), c);
+      const __m256i state = _mm256_and_si256(_mm256_i32gather_epi32(reinterpret_cast<const int*>(g), c, 1), low8);
+      const auto bits = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(state, covered))));
+      free_mask |= static_cast<uint64_t>(~bits & 0xFFu) << (8 * h);
+    }
+    if (!keep_free(free_mask, cells, i, g, grid.stride, stamp, limit, kept, count)) return count;
+  }
+  for (; i < n; ++i) {
+    uint8_t* cell = g + grid.cell(p[i]);
+    if (*cell == stamp) continue;
+    kept[count++] = i;
+    if (count >= limit) break;
+    mark_cover(cell, grid.stride, stamp);
+  }
+  return count;
+}
+#pragma GCC pop_options
+#endif
+
+bool use_avx2() {
+#ifdef PLSLAM_SSC_AVX2
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has && !detail::ssc_portable_only();
+#else
+  return false;
+#endif
+}
+
 // One greedy covering pass at width w over the sorted candidates. Stops once `limit` points are
-// kept (the caller then only needs to know it overshot). Returns the kept count.
+// kept (the caller then only needs to know it overshot). Returns the kept count; the sorted
+// positions of the kept points are in kept()[0, count).
 class Coverer {
  public:
-  Coverer(const std::vector<uint32_t>& packed, cv::Size size) : packed_(packed), size_(size) {}
+  Coverer(const SortedCandidates& sorted, cv::Size size, Workspace& ws) : sorted_(sorted), size_(size), ws_(ws) {}
 
-  int run(int w, int limit, std::vector<int>& kept_sorted_pos) {
-    // Cells of side c = w/2: the cell of pixel x is floor(2x / w).
-    const int cols = (2 * (size_.width - 1)) / w + 1;
-    const int rows = (2 * (size_.height - 1)) / w + 1;
-    // Two margin cells on each side so covering a 5x5 block needs no bounds checks.
-    const int stride = cols + 4;
-    grid_.assign(static_cast<std::size_t>(stride) * static_cast<std::size_t>(rows + 4), 0);
-    // Pixel -> cell lookups, filled incrementally (no division per pixel); the pass then needs no
-    // division or float conversion.
-    fill_cells(col_of_x_, size_.width, w, 1);
-    fill_cells(row_of_y_, size_.height, w, stride);
-    kept_sorted_pos.clear();
-    const int n = static_cast<int>(packed_.size());
-    uint8_t* g = grid_.data();
-    const uint32_t* p = packed_.data();
-    const int* cx = col_of_x_.data();
-    const int* ry = row_of_y_.data();
-    for (int i = 0; i < n; ++i) {
-      uint8_t* cell = g + ry[p[i] >> 16] + cx[p[i] & 0xFFFFu];
-      if (*cell) continue;
-      kept_sorted_pos.push_back(i);
-      if (static_cast<int>(kept_sorted_pos.size()) >= limit) break;
-      for (int dy = -2; dy <= 2; ++dy) {
-        uint8_t* row = cell + dy * stride;
-        row[-2] = row[-1] = row[0] = row[1] = row[2] = 1;
-      }
-    }
-    return static_cast<int>(kept_sorted_pos.size());
+  // Writes the sorted positions of the kept points to kept (room for `limit`).
+  int run(int w, int limit, int* kept) {
+    const Grid grid(size_, w);
+    uint8_t* g = ws_.grid_for_pass(grid.cells + 8);
+    const uint8_t stamp = ws_.stamp;
+#ifdef PLSLAM_SSC_AVX2
+    if (use_avx2() && grid.cells < (std::size_t{1} << 31)) return scan_avx2(sorted_, grid, g, stamp, limit, kept);
+#endif
+    return scan_portable(sorted_, grid, size_, g, stamp, limit, kept, ws_);
   }
 
  private:
-  // table[x] = (floor(2x / w) + 2) * scale for x in [0, n).
-  static void fill_cells(std::vector<int>& table, int n, int w, int scale) {
-    table.resize(static_cast<std::size_t>(n));
-    int q = 0, r = 0;  // 2x = q w + r, 0 <= r < w
-    for (int x = 0; x < n; ++x) {
-      table[static_cast<std::size_t>(x)] = (q + 2) * scale;
-      r += 2;
-      while (r >= w) {
-        r -= w;
-        ++q;
-      }
-    }
-  }
-
-  const std::vector<uint32_t>& packed_;
+  SortedCandidates sorted_;
   cv::Size size_;
-  std::vector<uint8_t> grid_;
-  std::vector<int> col_of_x_, row_of_y_;
+  Workspace& ws_;
 };
 
 }  // namespace
+
+namespace detail {
+int ssc_cell(uint32_t x, int w) { return Grid(cv::Size(1, 1), w).cell_of_coordinate(x); }
+}  // namespace detail
 
 SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
                      double tolerance_fraction, double width_hint) {
@@ -182,14 +451,18 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
     result.kept = order_by_response(keypoints);
     return result;
   }
-  const SortedCandidates sorted = sort_candidates(keypoints, size);
+  Workspace& ws = workspace();
+  const SortedCandidates sorted = sort_candidates(keypoints, size, ws);
   const int tolerance = static_cast<int>(std::floor(tolerance_fraction * target));
   const SscBounds bounds = ssc_width_bounds(k, target, size);
 
-  Coverer cover(sorted.packed, size);
-  std::vector<int> pass, best;
-  pass.reserve(static_cast<std::size_t>(target + tolerance + 1));
-  best.reserve(static_cast<std::size_t>(target + tolerance + 1));
+  Coverer cover(sorted, size, ws);
+  // Passes write into one of two buffers; a pass worth keeping becomes `best` by swapping roles.
+  const auto room = static_cast<std::size_t>(target + tolerance + 1);
+  std::array<int*, 2> buffers{ws.kept[0].get(room), ws.kept[1].get(room)};
+  int current = 0;
+  const int* best = nullptr;
+  int best_count = 0;
   double best_width = 0;
   // Integer widths, as in Bailo et al.: the count changes in steps anyway, and the search
   // ends after about log2(w_high) passes.
@@ -198,16 +471,20 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
   bool done = false;
   // One probe: true when the search is over (count within tolerance).
   auto probe = [&](int w) {
-    const int count = cover.run(w, target + tolerance + 1, pass);
+    const int count = cover.run(w, target + tolerance + 1, buffers[static_cast<std::size_t>(current)]);
     ++result.iterations;
-    if (std::abs(count - target) <= tolerance) {
-      best.swap(pass);
+    auto keep_pass = [&] {
+      best = buffers[static_cast<std::size_t>(current)];
+      best_count = count;
       best_width = w;
+      current ^= 1;
+    };
+    if (std::abs(count - target) <= tolerance) {
+      keep_pass();
       return true;
     }
     if (count > target) {
-      best.swap(pass);  // feasible: remember it, then try wider
-      best_width = w;
+      keep_pass();  // feasible: remember it, then try wider
       low = std::max(low, w + 1);
     } else {
       high = std::min(high, w - 1);
@@ -216,24 +493,31 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
   };
   const int hint = static_cast<int>(std::lround(width_hint));
   if (hint >= low && hint <= high) {
-    done = probe(hint);
-    // Feasible at the hint: the next width decides whether the hint was the widest.
-    if (!done && low == hint + 1 && low <= high) done = probe(hint + 1);
-    // Infeasible at the hint: try just below it.
-    else if (!done && high == hint - 1 && low <= high) done = probe(hint - 1);
+    // Gallop from the hint (steps 1, 1, 2, 4, ...) in the direction its outcome points to, until
+    // the outcome flips; the bisection then finishes inside the bracket. A hint that is right
+    // or off by one costs two or three passes instead of a bisection over the whole range.
+    int w = hint;
+    done = probe(w);
+    const bool wider = low > w;  // feasible at the hint: the widest feasible width is above
+    for (int n = 0; !done && low <= high && (low > w) == wider; ++n) {
+      const int step = n < 2 ? 1 : 1 << (n - 1);  // 1, 1, 2, 4, ...: widths drift slowly
+      w = wider ? std::min(w + step, high) : std::max(w - step, low);
+      done = probe(w);
+    }
   }
   while (!done && low <= high) done = probe(low + (high - low) / 2);
-  if (!done && best.empty()) {
+  if (!done && best == nullptr) {
     // Only possible with duplicate positions: fall back to the narrowest cover.
     const int w = std::max(1, static_cast<int>(std::floor(bounds.low)));
     best_width = w;
-    cover.run(w, target, best);
+    best = buffers[static_cast<std::size_t>(current)];
+    best_count = cover.run(w, target, buffers[static_cast<std::size_t>(current)]);
     ++result.iterations;
   }
-  if (static_cast<int>(best.size()) > target + tolerance) best.resize(static_cast<std::size_t>(target));
+  if (best_count > target + tolerance) best_count = target;
   result.width = best_width;
-  result.kept.reserve(best.size());
-  for (int pos : best) result.kept.push_back(sorted.index[static_cast<std::size_t>(pos)]);
+  result.kept.resize(static_cast<std::size_t>(best_count));
+  for (int i = 0; i < best_count; ++i) result.kept[static_cast<std::size_t>(i)] = sorted.index[best[i]];
   return result;
 }
 

@@ -2,7 +2,9 @@
 // Suppression via Square Covering (SSC, Bailo et al. 2018): keeps about N strong keypoints
 // spread homogeneously over the image. Candidates are visited strongest first; a kept point
 // covers the grid cells around it, and covered candidates are dropped. The cover width w is
-// found by a binary search between closed-form bounds (derived in ssc.cpp).
+// found by a search between closed-form bounds (derived in ssc.cpp), galloping from a hint.
+// Speed (ssc.cpp): one counting sort of the integer FAST scores, then passes that test 8
+// candidates at once with AVX2 when the CPU has it (a portable scan gives identical results).
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -29,16 +31,36 @@ struct SscResult {
 // overshoots within the tolerance it is returned as is; when the search converges without
 // hitting the tolerance the best overshooting covering is cut to exactly `target` (the first
 // `target` kept points of a greedy pass are themselves a valid covering result).
-// `width_hint` (optional, > 0): a likely width, probed first together with its successor, so
-// that a good hint (e.g. the width found on the neighbouring pyramid level, where the per-level
-// target follows the level area and the width barely changes) ends the search after two passes.
-// The bisection between the closed-form bounds takes over when the hint is wrong; the result
-// depends on the hint only through which feasible width is found first.
+// `width_hint` (optional, > 0): a likely width, probed first and then galloped from (steps 1, 1,
+// 2, 4, ... towards the outcome) until the outcome flips, so that a good hint (e.g. the width found
+// on the neighbouring pyramid level, where the per-level target follows the level area and the
+// width barely changes) ends the search after two or three passes. The bisection between the
+// closed-form bounds finishes inside the bracket; the result depends on the hint only through
+// which feasible width is found first.
 SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
                      double tolerance_fraction = 0.001, double width_hint = 0);
 
 // Indices of `keypoints` sorted by decreasing response, ties by index (a counting sort when the
 // responses are small integers, as FAST scores are).
 std::vector<int> order_by_response(const std::vector<cv::KeyPoint>& keypoints);
+
+namespace detail {
+// For tests: while alive, ssc_select on this thread uses the portable scan instead of AVX2
+// (the results must be identical).
+class PortableSscScope {
+ public:
+  PortableSscScope();
+  ~PortableSscScope();
+  PortableSscScope(const PortableSscScope&) = delete;
+  PortableSscScope& operator=(const PortableSscScope&) = delete;
+
+ private:
+  bool previous_;
+};
+bool ssc_portable_only();
+// The covering's cell of pixel coordinate x at width w, floor(2x / w), as the scans compute it
+// (float arithmetic, exact for x < 2^21); exposed for an exhaustive test.
+int ssc_cell(uint32_t x, int w);
+}  // namespace detail
 
 }  // namespace plslam::features
