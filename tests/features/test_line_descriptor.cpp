@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "features/line_synthetic_scene.h"
+#include "plslam/features/orb_descriptor.h"
 #include "plslam/features/line_extractor.h"
 #include "support/test_support.h"
 
@@ -44,7 +45,7 @@ WarpResult match_under_warp(const cv::Mat& img, const cv::Matx33d& H) {
     bool has = false;
     for (int j = 0; j < b.descriptors.rows; ++j) {
       has = has || same_line(i, j);
-      const int d = hamming256(a.descriptors.ptr<uint8_t>(i), b.descriptors.ptr<uint8_t>(j));
+      const int d = hamming_distance(a.descriptors.ptr<uint8_t>(i), b.descriptors.ptr<uint8_t>(j));
       if (d < best) {
         second = best;
         best = d;
@@ -96,10 +97,10 @@ TEST(LineDescriptor, MatchesUnderSmallViewpointChangeReal) {
 
 TEST(LineDescriptor, HammingAndShape) {
   uint8_t a[kLbdBytes] = {}, b[kLbdBytes] = {};
-  EXPECT_EQ(hamming256(a, b), 0);
+  EXPECT_EQ(hamming_distance(a, b), 0);
   b[0] = 0xFF;
   b[31] = 0x01;
-  EXPECT_EQ(hamming256(a, b), 9);
+  EXPECT_EQ(hamming_distance(a, b), 9);
   const auto s = test::make_line_scene(false);
   const DetectedLines d = detect_lines(s.left);
   const cv::Mat f = describe_lines_float(d.gradient, d.segments);

@@ -8,6 +8,7 @@
 #include "command_registry.h"
 #include "commands/dataset_options.h"
 #include "plslam/core/error.h"
+#include "plslam/core/sample_stats.h"
 #include "plslam/features/line_benchmark.h"
 #include "plslam/features/point_benchmark.h"
 #include "plslam/io/frame_stream.h"
@@ -45,7 +46,7 @@ nlohmann::json frame_benchmark(const io::Dataset& ds, bool kitti) {
     extractor.extract(id++, f->timestamp, f->left, f->right, &t);
     ms.push_back(t.total_ms);
   }
-  return features::summarize(ms);
+  return summarize(ms);
 }
 
 int run_bench_features(const BenchFeaturesArgs& args) {

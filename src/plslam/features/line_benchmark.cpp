@@ -1,5 +1,7 @@
 #include "plslam/features/line_benchmark.h"
 
+#include "plslam/core/sample_stats.h"
+
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
@@ -13,19 +15,6 @@ namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * (v.size() - 1);
-  const auto lo = static_cast<std::size_t>(pos);
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - lo) * (v[hi] - v[lo]);
-}
-
-nlohmann::json stats(const std::vector<double>& v) {
-  return {{"median", percentile(v, 0.5)}, {"p90", percentile(v, 0.9)}};
 }
 
 // OpenCV's binary LBD on our segments, for the cost comparison.
@@ -92,18 +81,18 @@ nlohmann::json benchmark_lines(const std::vector<std::pair<cv::Mat, cv::Mat>>& f
   }
   nlohmann::json j;
   j["frames"] = frames.size();
-  j["fast_lines_ms"] = stats(fast);
-  j["merge_ms"] = stats(merge);
-  j["lbd_ms"] = stats(lbd);
-  j["lines_image_ms"] = stats(image);
-  j["stereo_lines_ms"] = stats(stereo);
-  j["lines_detected"] = stats(detected);
-  j["lines_after_merge"] = stats(merged);
-  j["lines_kept"] = stats(kept);
-  j["stereo_line_matches"] = stats(matches);
+  j["fast_lines_ms"] = summarize(fast);
+  j["merge_ms"] = summarize(merge);
+  j["lbd_ms"] = summarize(lbd);
+  j["lines_image_ms"] = summarize(image);
+  j["stereo_lines_ms"] = summarize(stereo);
+  j["lines_detected"] = summarize(detected);
+  j["lines_after_merge"] = summarize(merged);
+  j["lines_kept"] = summarize(kept);
+  j["stereo_line_matches"] = summarize(matches);
   if (o.reference) {
-    j["lsd_ms"] = stats(lsd);
-    j["opencv_lbd_ms"] = stats(cv_lbd);
+    j["lsd_ms"] = summarize(lsd);
+    j["opencv_lbd_ms"] = summarize(cv_lbd);
     j["lines_speedup_vs_opencv"] = (percentile(lsd, 0.5) + percentile(cv_lbd, 0.5)) / percentile(image, 0.5);
   }
   return j;

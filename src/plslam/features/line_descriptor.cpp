@@ -166,15 +166,4 @@ cv::Mat describe_lines(const LineGradient& g, const std::vector<LineSegment>& se
   return out;
 }
 
-int hamming256(const uint8_t* a, const uint8_t* b) {
-  int d = 0;
-  for (int i = 0; i < kLbdBytes; i += 8) {
-    uint64_t x, y;
-    std::memcpy(&x, a + i, 8);
-    std::memcpy(&y, b + i, 8);
-    d += std::popcount(x ^ y);
-  }
-  return d;
-}
-
 }  // namespace plslam::features

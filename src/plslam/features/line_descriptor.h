@@ -32,6 +32,4 @@ cv::Mat describe_lines(const LineGradient& gradient, const std::vector<LineSegme
 cv::Mat describe_lines_float(const LineGradient& gradient, const std::vector<LineSegment>& segments,
                              const LbdOptions& options = {});
 
-int hamming256(const uint8_t* a, const uint8_t* b);
-
 }  // namespace plslam::features

@@ -1,5 +1,7 @@
 #include "plslam/features/point_benchmark.h"
 
+#include "plslam/core/sample_stats.h"
+
 #include <algorithm>
 #include <cmath>
 #include <ctime>
@@ -60,17 +62,6 @@ class SingleThreadedOpenCv {
 };
 
 }  // namespace
-
-nlohmann::json summarize(std::vector<double> values) {
-  if (values.empty()) return {{"median", nullptr}, {"p90", nullptr}, {"mean", nullptr}};
-  std::sort(values.begin(), values.end());
-  auto rank = [&](double q) {
-    const auto i = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1;
-    return values[std::min(i, values.size() - 1)];
-  };
-  const double mean = std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
-  return {{"median", rank(0.5)}, {"p90", rank(0.9)}, {"mean", mean}};
-}
 
 nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchmarkOptions& options) {
   OrbOptions orb = options.orb;

@@ -23,7 +23,5 @@ struct PointBenchmarkOptions {
 // (objects with median), ssc_speedup, and the configuration used.
 nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchmarkOptions& options);
 
-// Median / p90 / mean of a sample, as a JSON object (nearest-rank percentiles).
-nlohmann::json summarize(std::vector<double> values);
 
 }  // namespace plslam::features

@@ -1,12 +1,14 @@
 #include "plslam/map/descriptor_utils.h"
 
+#include "plslam/features/orb_descriptor.h"
+
 #include <algorithm>
 #include <limits>
 
 namespace plslam::map {
 
 int descriptor_distance(const cv::Mat& a, const cv::Mat& b) {
-  return static_cast<int>(cv::norm(a, b, cv::NORM_HAMMING));
+  return features::hamming_distance(a.ptr<uint8_t>(0), b.ptr<uint8_t>(0));
 }
 
 cv::Mat most_distinctive(const std::vector<cv::Mat>& descriptors) {

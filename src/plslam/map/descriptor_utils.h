@@ -6,7 +6,7 @@
 
 namespace plslam::map {
 
-// Hamming distance of two 1x32 CV_8U rows.
+// Hamming distance of two 1x32 CV_8U rows (ORB and LBD descriptors are both 256 bits).
 int descriptor_distance(const cv::Mat& a, const cv::Mat& b);
 
 // The descriptor with the smallest median distance to all others (ORB-SLAM2's choice of a

@@ -76,46 +76,29 @@ void LocalMapper::wait_idle() {
   cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || stop_requested_; });
 }
 
+void LocalMapper::process_front(std::unique_lock<std::mutex>& lock) {
+  map::KeyFrame* kf = queue_.front();
+  queue_.pop_front();
+  const bool more = !queue_.empty();
+  busy_ = true;
+  lock.unlock();
+  process(kf, more);
+  lock.lock();
+  busy_ = false;
+  cv_.notify_all();
+}
+
 void LocalMapper::process_pending() {
-  for (;;) {
-    map::KeyFrame* kf = nullptr;
-    bool more = false;
-    {
-      std::lock_guard lock(queue_mutex_);
-      if (queue_.empty()) return;
-      kf = queue_.front();
-      queue_.pop_front();
-      more = !queue_.empty();
-      busy_ = true;
-    }
-    process(kf, more);
-    {
-      std::lock_guard lock(queue_mutex_);
-      busy_ = false;
-    }
-    cv_.notify_all();
-  }
+  std::unique_lock lock(queue_mutex_);
+  while (!queue_.empty()) process_front(lock);
 }
 
 void LocalMapper::run() {
+  std::unique_lock lock(queue_mutex_);
   for (;;) {
-    map::KeyFrame* kf = nullptr;
-    bool more = false;
-    {
-      std::unique_lock lock(queue_mutex_);
-      cv_.wait(lock, [this] { return !queue_.empty() || stop_requested_; });
-      if (queue_.empty()) break;  // stop requested and nothing left
-      kf = queue_.front();
-      queue_.pop_front();
-      more = !queue_.empty();
-      busy_ = true;
-    }
-    process(kf, more);
-    {
-      std::lock_guard lock(queue_mutex_);
-      busy_ = false;
-    }
-    cv_.notify_all();
+    cv_.wait(lock, [this] { return !queue_.empty() || stop_requested_; });
+    if (queue_.empty()) break;  // stop requested and nothing left
+    process_front(lock);
   }
 }
 

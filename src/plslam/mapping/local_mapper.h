@@ -58,6 +58,8 @@ class LocalMapper {
 
  private:
   void run();
+  // Pops the front keyframe (lock held), processes it with the lock released, marks idle again.
+  void process_front(std::unique_lock<std::mutex>& lock);
   void process(map::KeyFrame* kf, bool more_waiting);
   void process_new_keyframe(map::KeyFrame* kf);
   void cull_recent(map::KeyFrame* kf);

@@ -1,3 +1,4 @@
+#include "plslam/features/orb_descriptor.h"
 #include "plslam/matching/stereo_line_matcher.h"
 
 #include <algorithm>
@@ -59,7 +60,7 @@ std::vector<StereoLineMatch> match_stereo_lines(const features::LineFeatures& L,
       const double ds = a.start.x - column_at_row(b, a.start.y);
       const double de = a.end.x - column_at_row(b, a.end.y);
       if (!(ds > 0 && de > 0 && ds <= max_disp && de <= max_disp)) continue;
-      const int dist = features::hamming256(L.descriptors.ptr<uint8_t>(i), R.descriptors.ptr<uint8_t>(j));
+      const int dist = features::hamming_distance(L.descriptors.ptr<uint8_t>(i), R.descriptors.ptr<uint8_t>(j));
       if (dist < best_l[i]) {
         second_l[i] = best_l[i];
         best_l[i] = dist;

@@ -1,5 +1,7 @@
 #include "plslam/system/run_report.h"
 
+#include "plslam/core/sample_stats.h"
+
 #include <algorithm>
 #include <numeric>
 
@@ -8,30 +10,6 @@
 #include "plslam/eval/evaluate.h"
 
 namespace plslam::system {
-namespace {
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const auto lo = static_cast<std::size_t>(pos);
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
-double mean(const std::vector<double>& v) {
-  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-}
-
-nlohmann::json timing(const std::vector<double>& v) {
-  return {{"median", percentile(v, 0.5)},
-          {"mean", mean(v)},
-          {"p90", percentile(v, 0.9)},
-          {"max", v.empty() ? 0.0 : *std::max_element(v.begin(), v.end())}};
-}
-
-}  // namespace
-
 void RunReport::add(const FrameResult& r) {
   ++frames;
   if (r.track.state == tracking::TrackingState::kOk) ++tracked_frames;
@@ -52,7 +30,7 @@ nlohmann::json RunReport::to_json(const System& slam) const {
           {"keyframes", slam.map().num_keyframes()},
           {"map_points", slam.map().num_points()},
           {"map_lines", slam.map().num_lines()},
-          {"tracking_ms", timing(tracking_ms)},
+          {"tracking_ms", summarize(tracking_ms)},
           {"stages_ms",
            {{"extraction", percentile(extraction_ms, 0.5)},
             {"stereo_matching", percentile(stereo_ms, 0.5)},

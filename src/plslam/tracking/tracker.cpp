@@ -122,28 +122,12 @@ bool Tracker::initialize(Frame& f) {
   for (float z : d.depth) stereo += z > 0;
   if (stereo < options_.init_min_points) return false;
   map::KeyFrame* kf = map_.create_keyframe(f.data, f.T_cw);
-  const geometry::StereoCamera cam(d.calib);
-  const geometry::SE3 T_wc = f.T_cw.inverse();
   for (std::size_t i = 0; i < d.keypoints.size(); ++i) {
-    if (d.depth[i] <= 0) continue;
-    const Eigen::Vector3d Xc = cam.unproject({d.keypoints[i].pt.x, d.keypoints[i].pt.y}, d.depth[i]);
-    map::MapPoint* mp = map_.create_point(T_wc * Xc, kf, f.id());
-    mp->add_observation(kf, static_cast<int>(i));
-    kf->add_map_point(mp, static_cast<int>(i));
-    mp->update_descriptor();
-    mp->update_normal_and_depth();
-    f.points[i] = mp;
+    if (d.depth[i] > 0) create_stereo_point(f, kf, i);
   }
   if (options_.lines) {
     for (std::size_t j = 0; j < d.lines.size(); ++j) {
-      const auto& l = d.lines[j];
-      if (!l.stereo) continue;
-      map::MapLine* ml = map_.create_line(T_wc * l.start_cam, T_wc * l.end_cam, kf, f.id());
-      ml->add_observation(kf, static_cast<int>(j));
-      kf->add_map_line(ml, static_cast<int>(j));
-      ml->update_descriptor();
-      ml->update_normal_and_depth();
-      f.lines[j] = ml;
+      if (d.lines[j].stereo) create_stereo_line(f, kf, j);
     }
   }
   f.reference = kf;
@@ -155,7 +139,7 @@ bool Tracker::initialize(Frame& f) {
   KeyframeInputs in;
   in.frame_id = f.id();
   in.timestamp = d.timestamp;
-  in.position = T_wc.translation();
+  in.position = f.camera_center();
   policy_.keyframe_inserted(in);
   spdlog::info("frame {}: new map segment with {} points and {} lines", f.id(), map_.num_points(),
                map_.num_lines());
@@ -360,11 +344,34 @@ KeyframeInputs Tracker::keyframe_inputs(const Frame& f, int point_inliers, int l
   return in;
 }
 
+void Tracker::create_stereo_point(Frame& f, map::KeyFrame* kf, std::size_t i) {
+  const auto& d = *f.data;
+  const geometry::StereoCamera cam(d.calib);
+  const Eigen::Vector3d Xc = cam.unproject({d.keypoints[i].pt.x, d.keypoints[i].pt.y}, d.depth[i]);
+  map::MapPoint* mp = map_.create_point(f.T_cw.inverse() * Xc, kf, f.id());
+  mp->add_observation(kf, static_cast<int>(i));
+  kf->add_map_point(mp, static_cast<int>(i));
+  mp->update_descriptor();
+  mp->update_normal_and_depth();
+  f.points[i] = mp;
+  f.point_outlier[i] = false;
+}
+
+void Tracker::create_stereo_line(Frame& f, map::KeyFrame* kf, std::size_t j) {
+  const auto& l = f.data->lines[j];
+  const geometry::SE3 T_wc = f.T_cw.inverse();
+  map::MapLine* ml = map_.create_line(T_wc * l.start_cam, T_wc * l.end_cam, kf, f.id());
+  ml->add_observation(kf, static_cast<int>(j));
+  kf->add_map_line(ml, static_cast<int>(j));
+  ml->update_descriptor();
+  ml->update_normal_and_depth();
+  f.lines[j] = ml;
+  f.line_outlier[j] = false;
+}
+
 map::KeyFrame* Tracker::create_keyframe(Frame& f) {
   const auto& d = *f.data;
   map::KeyFrame* kf = map_.create_keyframe(f.data, f.T_cw);
-  const geometry::StereoCamera cam(d.calib);
-  const geometry::SE3 T_wc = f.T_cw.inverse();
   // Tracked map points and lines: associated now, observations added by local mapping.
   for (std::size_t i = 0; i < f.points.size(); ++i) {
     if (f.points[i] && !f.point_outlier[i]) kf->add_map_point(f.points[i], static_cast<int>(i));
@@ -384,27 +391,14 @@ map::KeyFrame* Tracker::create_keyframe(Frame& f) {
     if (d.depth[i] > th && count >= options_.new_keyframe_points) break;
     ++count;
     if (f.points[i] && !f.point_outlier[i] && f.points[i]->num_observations() > 0) continue;
-    const Eigen::Vector3d Xc = cam.unproject({d.keypoints[i].pt.x, d.keypoints[i].pt.y}, d.depth[i]);
-    map::MapPoint* mp = map_.create_point(T_wc * Xc, kf, f.id());
-    mp->add_observation(kf, static_cast<int>(i));
-    kf->add_map_point(mp, static_cast<int>(i));
-    mp->update_descriptor();
-    mp->update_normal_and_depth();
-    f.points[i] = mp;
-    f.point_outlier[i] = false;
+    create_stereo_point(f, kf, i);
   }
   if (options_.lines) {
     for (std::size_t j = 0; j < d.lines.size(); ++j) {
       const auto& l = d.lines[j];
       if (!l.stereo || (f.lines[j] && !f.line_outlier[j])) continue;
       if (0.5 * (l.start_cam.z() + l.end_cam.z()) > th) continue;
-      map::MapLine* ml = map_.create_line(T_wc * l.start_cam, T_wc * l.end_cam, kf, f.id());
-      ml->add_observation(kf, static_cast<int>(j));
-      kf->add_map_line(ml, static_cast<int>(j));
-      ml->update_descriptor();
-      ml->update_normal_and_depth();
-      f.lines[j] = ml;
-      f.line_outlier[j] = false;
+      create_stereo_line(f, kf, j);
     }
   }
   reference_ = kf;

@@ -87,6 +87,9 @@ class Tracker {
   int optimize_pose(Frame& f, TrackStageTimes& t);
   void update_local_map(Frame& f);
   map::KeyFrame* create_keyframe(Frame& f);
+  // A map point (line) from the frame's stereo depth (3D endpoints), observed by `kf`.
+  void create_stereo_point(Frame& f, map::KeyFrame* kf, std::size_t i);
+  void create_stereo_line(Frame& f, map::KeyFrame* kf, std::size_t j);
   KeyframeInputs keyframe_inputs(const Frame& f, int point_inliers, int line_inliers) const;
   double close_depth(const Frame& f) const;
 

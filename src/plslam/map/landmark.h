@@ -1,0 +1,77 @@
+#pragma once
+// What map points and map lines have in common: observations by keyframes, a representative
+// descriptor, a mean viewing direction and distance range, tracking statistics for culling, and
+// the bad/replaced flags. Derived (CRTP) says where it sits in a keyframe:
+//   static Derived* slot(const KeyFrame&, int index);
+//   static void set_slot(KeyFrame&, int index, Derived* value);
+//   static cv::Mat descriptor_row(const KeyFrame&, int index);
+// Owned by the Map; the state is guarded by the landmark's own mutex because tracking reads it
+// while local mapping writes it. Member definitions: landmark_impl.h, instantiated by the derived
+// classes' .cpp files.
+#include <map>
+#include <mutex>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+namespace plslam::map {
+
+class KeyFrame;
+
+template <class Derived>
+class Landmark {
+ public:
+  Landmark(long id, KeyFrame* reference, long created_frame)
+      : id_(id), created_frame_(created_frame), reference_(reference) {}
+
+  long id() const { return id_; }
+  long created_frame() const { return created_frame_; }
+
+  // Observations: keyframe -> index of the feature in that keyframe.
+  void add_observation(KeyFrame* kf, int index);
+  // Removes one; a landmark left with fewer than two observing keyframes turns bad.
+  void erase_observation(KeyFrame* kf);
+  std::map<KeyFrame*, int> observations() const;
+  int num_observations() const;
+  int index_in(const KeyFrame* kf) const;  // -1 if not observed there
+  KeyFrame* reference() const;
+
+  // The most distinctive descriptor among the observations (smallest median Hamming distance).
+  void update_descriptor();
+  cv::Mat descriptor() const;
+  Eigen::Vector3d normal() const;
+  double min_distance() const;
+  double max_distance() const;
+
+  // Tracking statistics: how often it was predicted visible vs actually matched.
+  void increase_visible(int n = 1);
+  void increase_found(int n = 1);
+  double found_ratio() const;
+
+  bool is_bad() const;
+  // Flags it bad and removes it from every observing keyframe.
+  void set_bad();
+  // Hands its observations over to `other` (fusion of duplicates) and turns bad.
+  void replace_with(Derived* other);
+  Derived* replaced_by() const;
+
+ protected:
+  // For update_normal_and_depth() of the derived class: the mean viewing direction and range.
+  void set_normal_and_range(const Eigen::Vector3d& normal, double min_distance, double max_distance);
+
+  mutable std::mutex mutex_;
+
+ private:
+  const long id_;
+  const long created_frame_;
+  Eigen::Vector3d normal_ = Eigen::Vector3d::Zero();
+  cv::Mat descriptor_;
+  std::map<KeyFrame*, int> observations_;
+  KeyFrame* reference_;
+  double min_distance_ = 0, max_distance_ = 0;
+  int visible_ = 1, found_ = 1;
+  bool bad_ = false;
+  Derived* replaced_by_ = nullptr;
+};
+
+}  // namespace plslam::map

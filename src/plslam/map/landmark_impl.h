@@ -1,0 +1,172 @@
+#pragma once
+// Definitions of Landmark<Derived>; included by map_point.cpp and map_line.cpp only.
+#include <vector>
+
+#include "plslam/map/descriptor_utils.h"
+#include "plslam/map/keyframe.h"
+#include "plslam/map/landmark.h"
+
+namespace plslam::map {
+
+template <class D>
+void Landmark<D>::add_observation(KeyFrame* kf, int index) {
+  std::lock_guard lock(mutex_);
+  observations_[kf] = index;
+}
+
+template <class D>
+void Landmark<D>::erase_observation(KeyFrame* kf) {
+  bool now_bad = false;
+  {
+    std::lock_guard lock(mutex_);
+    if (!observations_.erase(kf)) return;
+    if (reference_ == kf && !observations_.empty()) reference_ = observations_.begin()->first;
+    // Seen by fewer than two keyframes, it carries no constraint between them: drop it.
+    now_bad = observations_.size() <= 1 && !bad_;
+  }
+  if (now_bad) set_bad();
+}
+
+template <class D>
+std::map<KeyFrame*, int> Landmark<D>::observations() const {
+  std::lock_guard lock(mutex_);
+  return observations_;
+}
+
+template <class D>
+int Landmark<D>::num_observations() const {
+  std::lock_guard lock(mutex_);
+  return static_cast<int>(observations_.size());
+}
+
+template <class D>
+int Landmark<D>::index_in(const KeyFrame* kf) const {
+  std::lock_guard lock(mutex_);
+  const auto it = observations_.find(const_cast<KeyFrame*>(kf));
+  return it == observations_.end() ? -1 : it->second;
+}
+
+template <class D>
+KeyFrame* Landmark<D>::reference() const {
+  std::lock_guard lock(mutex_);
+  return reference_;
+}
+
+template <class D>
+void Landmark<D>::update_descriptor() {
+  std::vector<cv::Mat> descs;
+  for (const auto& [kf, idx] : observations()) {
+    if (!kf->is_bad()) descs.push_back(D::descriptor_row(*kf, idx));
+  }
+  cv::Mat best = most_distinctive(descs);
+  if (best.empty()) return;
+  std::lock_guard lock(mutex_);
+  descriptor_ = best;
+}
+
+template <class D>
+cv::Mat Landmark<D>::descriptor() const {
+  std::lock_guard lock(mutex_);
+  return descriptor_;
+}
+
+template <class D>
+Eigen::Vector3d Landmark<D>::normal() const {
+  std::lock_guard lock(mutex_);
+  return normal_;
+}
+
+template <class D>
+double Landmark<D>::min_distance() const {
+  std::lock_guard lock(mutex_);
+  return min_distance_;
+}
+
+template <class D>
+double Landmark<D>::max_distance() const {
+  std::lock_guard lock(mutex_);
+  return max_distance_;
+}
+
+template <class D>
+void Landmark<D>::set_normal_and_range(const Eigen::Vector3d& normal, double min_distance, double max_distance) {
+  std::lock_guard lock(mutex_);
+  normal_ = normal;
+  min_distance_ = min_distance;
+  max_distance_ = max_distance;
+}
+
+template <class D>
+void Landmark<D>::increase_visible(int n) {
+  std::lock_guard lock(mutex_);
+  visible_ += n;
+}
+
+template <class D>
+void Landmark<D>::increase_found(int n) {
+  std::lock_guard lock(mutex_);
+  found_ += n;
+}
+
+template <class D>
+double Landmark<D>::found_ratio() const {
+  std::lock_guard lock(mutex_);
+  return static_cast<double>(found_) / std::max(visible_, 1);
+}
+
+template <class D>
+bool Landmark<D>::is_bad() const {
+  std::lock_guard lock(mutex_);
+  return bad_;
+}
+
+template <class D>
+void Landmark<D>::set_bad() {
+  std::map<KeyFrame*, int> obs;
+  {
+    std::lock_guard lock(mutex_);
+    if (bad_) return;
+    bad_ = true;
+    obs.swap(observations_);
+  }
+  D* self = static_cast<D*>(this);
+  for (const auto& [kf, idx] : obs) {
+    if (D::slot(*kf, idx) == self) D::set_slot(*kf, idx, nullptr);
+  }
+}
+
+template <class D>
+void Landmark<D>::replace_with(D* other) {
+  D* self = static_cast<D*>(this);
+  if (other == self || !other) return;
+  std::map<KeyFrame*, int> obs;
+  int visible = 0, found = 0;
+  {
+    std::lock_guard lock(mutex_);
+    if (bad_) return;
+    bad_ = true;
+    obs.swap(observations_);
+    visible = visible_;
+    found = found_;
+    replaced_by_ = other;
+  }
+  for (const auto& [kf, idx] : obs) {
+    if (other->index_in(kf) < 0) {
+      D::set_slot(*kf, idx, other);
+      other->add_observation(kf, idx);
+    } else if (D::slot(*kf, idx) == self) {
+      D::set_slot(*kf, idx, nullptr);
+    }
+  }
+  other->increase_visible(visible);
+  other->increase_found(found);
+  other->update_descriptor();
+}
+
+template <class D>
+D* Landmark<D>::replaced_by() const {
+  std::lock_guard lock(mutex_);
+  return replaced_by_;
+}
+
+}  // namespace plslam::map
