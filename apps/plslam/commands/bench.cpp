@@ -66,6 +66,8 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   const bool kitti = ds->format() == io::DatasetFormat::kKitti;
   features::LineBenchmarkOptions lo;
   lo.extractor = kitti ? features::LineExtractorOptions::kitti() : features::LineExtractorOptions::euroc();
+  // As the SLAM front end keeps them: only lines steep enough for stereo compete for the N places.
+  lo.extractor.min_angle_from_horizontal_deg = lo.stereo.min_angle_from_horizontal_deg;
   j.update(features::benchmark_lines(*ds, 0, lo));
   j["frame_ms"] = frame_benchmark(*ds, kitti);
   if (args.json) {

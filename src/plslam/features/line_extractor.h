@@ -18,6 +18,9 @@ struct LineExtractorOptions {
   LineMergeOptions merge;
   bool merge_enabled = true;
   std::size_t max_lines = 200;  // 200 for EuRoC, 500 for KITTI
+  // Drop lines flatter than this before keeping the best N (0: keep all). The SLAM front end sets
+  // it to the stereo matcher's limit, since only stereo lines enter its optimisation.
+  double min_angle_from_horizontal_deg = 0;
   LbdOptions lbd;
 
   static LineExtractorOptions euroc() { return {}; }
