@@ -38,7 +38,7 @@ class Landmark {
 
   // The most distinctive descriptor among the observations (smallest median Hamming distance).
   void update_descriptor();
-  cv::Mat descriptor() const;
+  cv::Mat descriptor() const;  // the caller's own copy
   Eigen::Vector3d normal() const;
   double min_distance() const;
   double max_distance() const;

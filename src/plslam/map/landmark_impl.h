@@ -67,7 +67,9 @@ void Landmark<D>::update_descriptor() {
 template <class D>
 cv::Mat Landmark<D>::descriptor() const {
   std::lock_guard lock(mutex_);
-  return descriptor_;
+  // A deep copy: a cv::Mat copy would share the buffer (and its reference count) with the
+  // mapping thread, which replaces the descriptor while tracking reads it.
+  return descriptor_.clone();
 }
 
 template <class D>

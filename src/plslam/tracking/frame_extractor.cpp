@@ -2,7 +2,8 @@
 
 #include <chrono>
 
-#include <tbb/task_group.h>
+#include <future>
+#include <vector>
 
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/matching/stereo_point_frame.h"
@@ -49,34 +50,34 @@ std::shared_ptr<map::FrameData> FrameExtractor::extract(long frame_id, double ti
   features::ExtractionTimings tl;
   features::LineTimings tll;
   {
-    tbb::task_group tasks;
-    tasks.run([&] { pl = left_orb_.extract(left, &tl); });
-    tasks.run([&] { pr = right_orb_.extract(right); });
+    // Plain threads rather than a TBB task group: the join is a synchronisation ThreadSanitizer
+    // can see (libtbb is not instrumented), and four coarse tasks do not need a scheduler.
+    std::vector<std::future<void>> tasks;
+    tasks.push_back(std::async(std::launch::async, [&] { pr = right_orb_.extract(right); }));
     if (options_.lines) {
-      tasks.run([&] { ll = features::extract_lines(left, options_.line_extractor, &tll); });
-      tasks.run([&] { lr = features::extract_lines(right, options_.line_extractor); });
+      tasks.push_back(std::async(std::launch::async, [&] { ll = features::extract_lines(left, options_.line_extractor, &tll); }));
+      tasks.push_back(std::async(std::launch::async, [&] { lr = features::extract_lines(right, options_.line_extractor); }));
     }
-    tasks.wait();
+    pl = left_orb_.extract(left, &tl);
+    for (auto& t : tasks) t.get();
   }
   const auto t1 = std::chrono::steady_clock::now();
   matching::StereoPointMatches sp;
   std::vector<matching::StereoLineMatch> sl;
   double sp_ms = 0, sl_ms = 0;
   {
-    tbb::task_group tasks;
-    tasks.run([&] {
-      const auto s = std::chrono::steady_clock::now();
-      sp = matching::match_stereo_points(pl, pr, options_.stereo_points);
-      sp_ms = ms_since(s);
-    });
+    std::future<void> lines_task;
     if (options_.lines) {
-      tasks.run([&] {
+      lines_task = std::async(std::launch::async, [&] {
         const auto s = std::chrono::steady_clock::now();
         sl = matching::match_stereo_lines(ll, lr, calib_, options_.stereo_lines);
         sl_ms = ms_since(s);
       });
     }
-    tasks.wait();
+    const auto s = std::chrono::steady_clock::now();
+    sp = matching::match_stereo_points(pl, pr, options_.stereo_points);
+    sp_ms = ms_since(s);
+    if (lines_task.valid()) lines_task.get();
   }
   const auto t2 = std::chrono::steady_clock::now();
 
