@@ -1,5 +1,7 @@
 #include "plslam/features/line_benchmark.h"
 
+#include "plslam/core/stopwatch.h"
+
 #include "plslam/core/sample_stats.h"
 
 #include <algorithm>
@@ -12,10 +14,6 @@
 namespace plslam::features {
 
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // OpenCV's binary LBD on our segments, for the cost comparison.
 double opencv_lbd_ms(const cv::Mat& grey, const std::vector<LineSegment>& lines) {

@@ -1,13 +1,12 @@
 #include "plslam/features/line_extractor.h"
 
+#include "plslam/core/stopwatch.h"
+
 #include <chrono>
 
 namespace plslam::features {
 
 namespace {
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 }  // namespace
 
 LineFeatures extract_lines(const cv::Mat& grey, const LineExtractorOptions& o, LineTimings* timings) {

@@ -1,5 +1,7 @@
 #include "plslam/features/orb_extractor.h"
 
+#include "plslam/core/stopwatch.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,10 +18,6 @@ namespace plslam::features {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 // Pyramid border: a rotated BRIEF sample reaches 13*sqrt(2) < 19 px from the keypoint.
 constexpr int kPyramidBorder = 19;
 constexpr int kBriefReach = 19;

@@ -1,5 +1,7 @@
 #include "plslam/mapping/local_mapper.h"
 
+#include "plslam/core/stopwatch.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,10 +20,6 @@ namespace plslam::mapping {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 constexpr double kChi2Mono = 5.991;
 
 }  // namespace

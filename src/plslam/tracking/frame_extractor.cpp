@@ -1,5 +1,7 @@
 #include "plslam/tracking/frame_extractor.h"
 
+#include "plslam/core/stopwatch.h"
+
 #include <chrono>
 
 #include <future>
@@ -10,10 +12,6 @@
 
 namespace plslam::tracking {
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 }  // namespace
 

@@ -1,5 +1,7 @@
 #include "plslam/tracking/tracker.h"
 
+#include "plslam/core/stopwatch.h"
+
 #include <algorithm>
 #include <chrono>
 #include <map>
@@ -14,10 +16,6 @@ namespace plslam::tracking {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 }  // namespace
 
 const char* to_string(TrackingState s) {
