@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/line_descriptor.hpp>
 
+#include "plslam/features/line_benchmark.h"
 #include "plslam/features/line_extractor.h"
 #include "plslam/io/dataset.h"
 #include "plslam/matching/stereo_line_matcher.h"
@@ -149,20 +150,7 @@ void BM_LbdOpenCV(benchmark::State& state) {
   for (auto _ : state) {
     const std::size_t k = i++ % kept.size();
     state.PauseTiming();
-    std::vector<cv::line_descriptor::KeyLine> kls;
-    for (const auto& l : kept[k].second) {
-      cv::line_descriptor::KeyLine kl;
-      kl.startPointX = kl.sPointInOctaveX = l.start.x;
-      kl.startPointY = kl.sPointInOctaveY = l.start.y;
-      kl.endPointX = kl.ePointInOctaveX = l.end.x;
-      kl.endPointY = kl.ePointInOctaveY = l.end.y;
-      kl.lineLength = l.length();
-      kl.numOfPixels = static_cast<int>(l.length());
-      kl.angle = l.angle();
-      kl.pt = 0.5f * (l.start + l.end);
-      kl.class_id = static_cast<int>(kls.size());
-      kls.push_back(kl);
-    }
+    auto kls = to_keylines(kept[k].second, s.frames[k].first.size());
     state.ResumeTiming();
     cv::Mat desc;
     bd->compute(s.frames[k].first, kls, desc);

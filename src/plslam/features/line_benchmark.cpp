@@ -13,10 +13,7 @@
 
 namespace plslam::features {
 
-namespace {
-
-// OpenCV's binary LBD on our segments, for the cost comparison.
-double opencv_lbd_ms(const cv::Mat& grey, const std::vector<LineSegment>& lines) {
+std::vector<cv::line_descriptor::KeyLine> to_keylines(const std::vector<LineSegment>& lines, cv::Size image_size) {
   std::vector<cv::line_descriptor::KeyLine> kls;
   kls.reserve(lines.size());
   for (std::size_t i = 0; i < lines.size(); ++i) {
@@ -32,9 +29,17 @@ double opencv_lbd_ms(const cv::Mat& grey, const std::vector<LineSegment>& lines)
     k.octave = 0;
     k.class_id = static_cast<int>(i);
     k.pt = 0.5f * (s.start + s.end);
-    k.response = s.length() / std::max(grey.cols, grey.rows);
+    k.response = s.length() / std::max(image_size.width, image_size.height);
     kls.push_back(k);
   }
+  return kls;
+}
+
+namespace {
+
+// OpenCV's binary LBD on our segments, for the cost comparison.
+double opencv_lbd_ms(const cv::Mat& grey, const std::vector<LineSegment>& lines) {
+  std::vector<cv::line_descriptor::KeyLine> kls = to_keylines(lines, grey.size());
   auto bd = cv::line_descriptor::BinaryDescriptor::createBinaryDescriptor();
   cv::Mat desc;
   const auto t0 = std::chrono::steady_clock::now();

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/line_descriptor.hpp>
 
 #include "plslam/core/types.h"
 #include "plslam/features/line_extractor.h"
@@ -25,6 +26,9 @@ struct LineBenchmarkOptions {
 // lines_image_ms (detect+merge+describe, one image), opencv_lbd_ms, stereo_lines_ms,
 // lines_detected, lines_after_merge, lines_kept, stereo_line_matches; plus frames and
 // lines_speedup_vs_opencv (median OpenCV LSD + LBD over median lines_image_ms).
+// Our segments as OpenCV KeyLines (octave 0), to run OpenCV's LBD on exactly the same lines.
+std::vector<cv::line_descriptor::KeyLine> to_keylines(const std::vector<LineSegment>& lines, cv::Size image_size);
+
 nlohmann::json benchmark_lines(const std::vector<std::pair<cv::Mat, cv::Mat>>& stereo_frames,
                                const StereoCalibration& calib, const LineBenchmarkOptions& options = {});
 
