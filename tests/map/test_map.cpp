@@ -156,5 +156,27 @@ TEST(FrameData, GridSearchFindsExactlyThePointsInTheRadius) {
   EXPECT_FALSE(brute.empty());
 }
 
+TEST(FrameData, StereoConstraintStopsAtTheFarDepth) {
+  FrameData d;
+  d.calib.baseline = 0.5;
+  d.u_right = {100.f, -1.f, 50.f, 80.f};
+  d.depth = {5.f, -1.f, 10.f, 10.5f};  // 10, -, 20 and 21 baselines
+  EXPECT_TRUE(d.stereo_constraint(0, 20));
+  EXPECT_FALSE(d.stereo_constraint(1, 20));  // no right match
+  EXPECT_TRUE(d.stereo_constraint(2, 20));   // at the limit
+  EXPECT_FALSE(d.stereo_constraint(3, 20));
+  EXPECT_TRUE(d.stereo_constraint(3, 0));    // 0: no limit
+  EXPECT_FALSE(d.stereo_constraint(1, 0));
+}
+
+TEST(FrameData, LevelScalesArePowersOfTheScaleFactor) {
+  FrameData d;
+  d.scale_factor = 1.2;
+  for (int l = 0; l < 8; ++l) {
+    EXPECT_NEAR(d.level_scale(l), std::pow(1.2, l), 1e-12);
+    EXPECT_NEAR(d.level_sigma2(l), std::pow(1.2, 2 * l), 1e-12);
+  }
+}
+
 }  // namespace
 }  // namespace plslam::map

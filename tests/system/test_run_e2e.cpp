@@ -86,9 +86,26 @@ TEST(RunEndToEnd, Kitti06IsTrackedWithinBound) {
   EXPECT_EQ(stats["lost_events"], 0);
   const double ate = stats["accuracy"]["ape_trans_m"]["rmse"].get<double>();
   RecordProperty("ate_m", std::to_string(ate));
-  // ORB-SLAM3 gets 0.042 m on these frames; the issue's target is 0.063 m. This bound guards
-  // against regressions (tracking failures give metres), not the target itself.
-  EXPECT_LT(ate, 0.15);
+  // ORB-SLAM3 gets 0.042 m on these frames and the issue's target is 0.063 m (1.5x); sequential
+  // runs give 0.021-0.028 m. Letting the far points' stereo matches constrain the scale gave 0.10.
+  EXPECT_LT(ate, 0.063);
+}
+
+TEST(RunEndToEnd, Kitti01HighwayIsTrackedWithinBound) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto out = tmp.path() / "run";
+  const auto r = test::run_cli("run \"" + (data / "kitti/sequences/01").string() + "\" --out \"" + out.string() +
+                               "\" --quiet --sequential");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto stats = read_json(out / "stats.json");
+  EXPECT_EQ(stats["tracked_frames"], 51);
+  EXPECT_EQ(stats["lost_events"], 0);
+  const double ate = stats["accuracy"]["ape_trans_m"]["rmse"].get<double>();
+  RecordProperty("ate_m", std::to_string(ate));
+  // ORB-SLAM3: 0.75 m; the issue's target 1.1 m; sequential runs give 0.36-0.38 m (1.04 m with
+  // every far stereo match as a constraint).
+  EXPECT_LT(ate, 0.75);
 }
 
 TEST(RunEndToEnd, UnknownConfigKeyIsAnErrorNamingIt) {

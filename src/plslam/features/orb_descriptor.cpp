@@ -133,6 +133,12 @@ void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uin
   }
 }
 
+// Matching calls this millions of times per second. The build targets baseline x86-64, where
+// std::popcount is a libgcc call; a clone with the POPCNT instruction is picked at load time
+// when the CPU has it (GCC function multi-versioning), with identical results.
+#if defined(__x86_64__) && !defined(__clang__)
+__attribute__((target_clones("popcnt", "default")))
+#endif
 int hamming_distance(const uint8_t* a, const uint8_t* b) {
   int d = 0;
   for (int i = 0; i < kOrbDescriptorBytes; i += 8) {

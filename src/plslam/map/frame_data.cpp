@@ -40,7 +40,16 @@ std::vector<int> FrameData::points_in_area(double u, double v, double r, int min
   return out;
 }
 
-double FrameData::level_scale(int level) const { return std::pow(scale_factor, level); }
-double FrameData::level_sigma2(int level) const { return std::pow(scale_factor, 2 * level); }
+// Products instead of std::pow: these sit in the inner loops of matching and triangulation, and
+// levels are small non-negative integers.
+double FrameData::level_scale(int level) const {
+  double s = 1.0;
+  for (int l = 0; l < level; ++l) s *= scale_factor;
+  return s;
+}
+double FrameData::level_sigma2(int level) const {
+  const double s = level_scale(level);
+  return s * s;
+}
 
 }  // namespace plslam::map

@@ -48,6 +48,15 @@ struct FrameData {
   // (max_level < 0: no upper bound).
   std::vector<int> points_in_area(double u, double v, double r, int min_level = 0, int max_level = -1) const;
 
+  // Whether keypoint i's right-image match constrains optimisation: it has one, and its depth is
+  // at most `max_depth_baselines` baselines (<= 0: any depth). Beyond that the match still gives
+  // the point its first depth, but a constant disparity error of a fraction of a pixel (imperfect
+  // rectification) would bias the scale through the far points; their left-image observations
+  // keep constraining rotation (ORB-SLAM2's close/far split).
+  bool stereo_constraint(std::size_t i, double max_depth_baselines) const {
+    return u_right[i] >= 0 && (max_depth_baselines <= 0 || depth[i] <= max_depth_baselines * calib.baseline);
+  }
+
   double level_scale(int level) const;        // scale_factor^level
   double level_sigma2(int level) const;       // scale_factor^(2 level)
   std::size_t num_points() const { return keypoints.size(); }

@@ -12,9 +12,11 @@
 
 #include <spdlog/spdlog.h>
 
+#include "plslam/features/orb_descriptor.h"
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/geometry/triangulation.h"
 #include "plslam/map/descriptor_utils.h"
+#include "plslam/mapping/epipolar_index.h"
 
 namespace plslam::mapping {
 namespace {
@@ -104,15 +106,22 @@ void LocalMapper::process(map::KeyFrame* kf, bool more_waiting) {
   const auto t0 = Clock::now();
   process_new_keyframe(kf);
   cull_recent(kf);
+  auto t = Clock::now();
   triangulate(kf);
+  const double triangulation_ms = ms_since(t);
+  double fusion_ms = -1;
   // Like ORB-SLAM2: the expensive steps only when tracking is not waiting with more keyframes.
   if (!more_waiting) {
+    t = Clock::now();
     fuse(kf);
+    fusion_ms = ms_since(t);
     if (options_.local_ba && map_.num_keyframes() > 2) local_bundle_adjustment(kf);
     cull_keyframes(kf);
   }
   std::lock_guard lock(stats_mutex_);
   stats_.keyframe_ms.push_back(ms_since(t0));
+  stats_.triangulation_ms.push_back(triangulation_ms);
+  if (fusion_ms >= 0) stats_.fusion_ms.push_back(fusion_ms);
 }
 
 void LocalMapper::process_new_keyframe(map::KeyFrame* kf) {
@@ -189,10 +198,26 @@ void LocalMapper::triangulate(map::KeyFrame* kf) {
     K << d1.calib.fx, 0, d1.calib.cx, 0, d1.calib.fy, d1.calib.cy, 0, 0, 1;
     const Eigen::Matrix3d Kinv = K.inverse();
     const Eigen::Matrix3d F12 = Kinv.transpose() * geometry::hat(t12) * R12 * Kinv;
-    std::vector<int> free2;
+    // Free keypoints of kf2, indexed per level around the epipole (camera 1's centre seen from
+    // camera 2), so that each level is searched with its own band.
+    const geometry::SE3 T21 = T12.inverse();
+    const Eigen::Vector3d epipole = K * T21.translation();
+    const Eigen::Matrix3d H21 = K * T21.rotation() * Kinv;  // x1 -> image-2 direction of its ray
+    std::vector<std::vector<int>> free2(static_cast<std::size_t>(d2.levels));
+    std::vector<std::vector<Eigen::Vector2d>> free2_position(free2.size());
     for (std::size_t j = 0; j < points2.size(); ++j) {
-      if (!points2[j]) free2.push_back(static_cast<int>(j));
+      if (points2[j]) continue;
+      const auto level = static_cast<std::size_t>(std::clamp(d2.keypoints[j].octave, 0, d2.levels - 1));
+      free2[level].push_back(static_cast<int>(j));
+      free2_position[level].emplace_back(d2.keypoints[j].pt.x, d2.keypoints[j].pt.y);
     }
+    std::vector<EpipolarIndex> index;
+    std::vector<double> band;  // the epipolar test's gate below, plus rounding
+    for (std::size_t l = 0; l < free2.size(); ++l) {
+      index.emplace_back(free2_position[l], epipole);
+      band.push_back(std::sqrt(3.84 * d2.level_sigma2(static_cast<int>(l))) + 1e-6);
+    }
+    std::vector<int> candidates;
     std::vector<bool> used2(points2.size(), false);
     for (std::size_t i = 0; i < points1.size(); ++i) {
       if (points1[i] || kf->map_point(static_cast<int>(i))) continue;
@@ -201,15 +226,27 @@ void LocalMapper::triangulate(map::KeyFrame* kf) {
       const Eigen::Vector3d epiline = F12.transpose() * x1;  // line in image 2
       const double norm = std::hypot(epiline.x(), epiline.y());
       int best = 50, best_j = -1;  // ORB-SLAM2's TH_LOW
-      for (int j : free2) {
-        if (used2[static_cast<std::size_t>(j)]) continue;
-        const auto& kp2 = d2.keypoints[static_cast<std::size_t>(j)];
-        const double dist_epi = std::abs(epiline.x() * kp2.pt.x + epiline.y() * kp2.pt.y + epiline.z()) / norm;
-        if (dist_epi * dist_epi > 3.84 * d2.level_sigma2(kp2.octave)) continue;
-        const int h = map::descriptor_distance(d1.descriptors.row(static_cast<int>(i)), d2.descriptors.row(j));
-        if (h < best) {
-          best = h;
-          best_j = j;
+      EpipolarIndex::Ray ray;
+      const bool has_ray = index.front().ray(H21 * x1, &ray);
+      for (std::size_t l = 0; l < index.size(); ++l) {
+        if (free2[l].empty()) continue;
+        if (has_ray) {
+          index[l].query(ray, band[l], &candidates);
+        } else {
+          index[l].query_all(&candidates);
+        }
+        for (int c : candidates) {
+          const int j = free2[l][static_cast<std::size_t>(c)];
+          if (used2[static_cast<std::size_t>(j)]) continue;
+          const auto& kp2 = d2.keypoints[static_cast<std::size_t>(j)];
+          const double dist_epi = std::abs(epiline.x() * kp2.pt.x + epiline.y() * kp2.pt.y + epiline.z()) / norm;
+          if (dist_epi * dist_epi > 3.84 * d2.level_sigma2(kp2.octave)) continue;
+          const int h = features::hamming_distance(d1.descriptors.ptr<uint8_t>(static_cast<int>(i)),
+                                                   d2.descriptors.ptr<uint8_t>(j));
+          if (h < best || (h == best && j < best_j)) {  // ties: the lowest index, whatever the query order
+            best = h;
+            best_j = j;
+          }
         }
       }
       if (best_j < 0) continue;
@@ -248,8 +285,8 @@ void LocalMapper::triangulate(map::KeyFrame* kf) {
       int best = 60, best_b = -1;
       for (std::size_t b = 0; b < lines2.size(); ++b) {
         if (lines2[b]) continue;
-        const int h = map::descriptor_distance(d1.line_descriptors.row(static_cast<int>(a)),
-                                               d2.line_descriptors.row(static_cast<int>(b)));
+        const int h = features::hamming_distance(d1.line_descriptors.ptr<uint8_t>(static_cast<int>(a)),
+                                                 d2.line_descriptors.ptr<uint8_t>(static_cast<int>(b)));
         if (h < best) {
           best = h;
           best_b = static_cast<int>(b);
@@ -394,7 +431,7 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf) {
       o.keyframe = kf_index[k];
       o.point = static_cast<int>(p);
       o.measurement = {kp.pt.x, kp.pt.y, d.u_right[static_cast<std::size_t>(idx)]};
-      o.has_right = d.u_right[static_cast<std::size_t>(idx)] >= 0;
+      o.has_right = d.stereo_constraint(static_cast<std::size_t>(idx), options_.far_stereo_baselines);
       o.level = kp.octave;
       problem.point_observations.push_back(o);
       point_refs.push_back({points[p], k});

@@ -21,6 +21,7 @@ struct LocalMapperOptions {
   int ba_iterations = 5;         // first pass (ORB-SLAM2: 5 + 10 without outliers)
   int ba_second_iterations = 10;
   double line_information = 0.5;
+  double far_stereo_baselines = 0;  // as TrackerOptions (set by the system from it)
   double culling_redundancy = 0.9;  // a keyframe is redundant when this share of its points is seen by 3 others
   int triangulation_neighbors = 10;
   bool lines = true;
@@ -29,6 +30,8 @@ struct LocalMapperOptions {
 struct LocalMapperStats {
   std::vector<double> local_ba_ms;
   std::vector<double> keyframe_ms;
+  std::vector<double> triangulation_ms;  // per keyframe
+  std::vector<double> fusion_ms;         // per keyframe that ran it
   int culled_keyframes = 0;
   int triangulated_points = 0;
   int fused_points = 0;

@@ -38,6 +38,10 @@ nlohmann::json RunReport::to_json(const System& slam) const {
             {"track_local_map", percentile(track_local_map_ms, 0.5)},
             {"pose_optimization", percentile(pose_optimization_ms, 0.5)}}},
           {"local_ba_ms", {{"median", percentile(ms.local_ba_ms, 0.5)}, {"count", ms.local_ba_ms.size()}}},
+          {"mapping_ms",
+           {{"keyframe", percentile(ms.keyframe_ms, 0.5)},
+            {"triangulation", percentile(ms.triangulation_ms, 0.5)},
+            {"fusion", percentile(ms.fusion_ms, 0.5)}}},
           {"culled_keyframes", ms.culled_keyframes},
           {"triangulated_points", ms.triangulated_points}};
 }

@@ -33,6 +33,8 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
   const auto tracking = config.section("tracking");
   tracking.get("init_min_points", o.tracker.init_min_points);
   tracking.get("close_depth_baselines", o.tracker.close_depth_baselines);
+  tracking.get("far_stereo_baselines", o.tracker.far_stereo_baselines);
+  if (o.tracker.far_stereo_baselines < 0) throw InputError(config.source(), "tracking.far_stereo_baselines: must be >= 0");
   tracking.get("motion_radius", o.tracker.motion_radius);
   tracking.get("local_map_radius", o.tracker.local_map_radius);
   tracking.get("line_radius", o.tracker.line_radius);

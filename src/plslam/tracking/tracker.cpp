@@ -155,7 +155,7 @@ int Tracker::optimize_pose(Frame& f, TrackStageTimes& t) {
     optim::PosePointTerm term;
     term.world = mp->position();
     term.obs.measurement = {d.keypoints[i].pt.x, d.keypoints[i].pt.y, d.u_right[i]};
-    term.obs.has_right = d.u_right[i] >= 0;
+    term.obs.has_right = d.stereo_constraint(i, options_.far_stereo_baselines);
     term.obs.level = d.keypoints[i].octave;
     pts.push_back(term);
     pidx.push_back(i);

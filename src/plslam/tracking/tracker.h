@@ -20,6 +20,9 @@ namespace plslam::tracking {
 struct TrackerOptions {
   int init_min_points = 500;          // stereo points needed to start a map
   double close_depth_baselines = 40;  // "close" stereo points: depth < 40 baselines (ORB-SLAM2)
+  // Right-image matches of points beyond this depth (baselines) are not optimisation constraints
+  // (map::FrameData::stereo_constraint); 0: all are.
+  double far_stereo_baselines = 0;
   int new_keyframe_points = 100;      // a keyframe creates at least this many points (closest first)
   double motion_radius = 7.0;         // px at level 0, motion-model search (ORB-SLAM2 stereo)
   double local_map_radius = 1.0;      // px factor, local-map search (times 2.5 or 4 and the level scale)
