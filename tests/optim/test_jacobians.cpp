@@ -259,6 +259,48 @@ TEST(Jacobians, RelativePoseEdge) {
   std::printf("relative pose edge: worst relative error %.2e over %d configs\n", worst, kConfigs);
 }
 
+// The structured normal equations the optimisers accumulate (stereo_point_weighted_normal and
+// add_pose_normal_equations) against the products of the explicit Jacobians.
+TEST(Jacobians, StereoPointNormalEquationsFromStructure) {
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> weight(0.05, 3.0);
+  for (int i = 0; i < kConfigs; ++i) {
+    const SE3 T = test::random_pose(rng, 5.0, 1.0);
+    const Eigen::Vector3d X = test::world_point_at(cam, T, pixel_maybe_at_border(cam, rng),
+                                                   test::random_depth(rng, 0.3, 80.0));
+    const Eigen::Vector3d z = cam.project_stereo(T * X) + Eigen::Vector3d(3.0, -2.0, 1.5);
+    const bool has_right = i % 5 != 0;
+    const double w = weight(rng);
+    Eigen::Vector3d r;
+    Matrix36d Jp;
+    Eigen::Matrix3d Jx;
+    ASSERT_TRUE(evaluate_stereo_point(cam, T, X, z, has_right, &r, &Jp, &Jx));
+    const Eigen::Vector3d Xc = T * X;
+    EXPECT_EQ((stereo_point_residual_at(cam, Xc, z, has_right) - r).norm(), 0.0);
+    Eigen::Matrix3d B;
+    Eigen::Vector3d a;
+    stereo_point_weighted_normal(cam, Xc, r, has_right, w, &B, &a);
+    geometry::Matrix6d H = geometry::Matrix6d::Zero();
+    Vector6d g = Vector6d::Zero();
+    add_pose_normal_equations(B, a, Xc, H, g);
+    const geometry::Matrix6d H_ref = w * Jp.transpose() * Jp;
+    const Vector6d g_ref = w * Jp.transpose() * r;
+    const Eigen::Matrix3d Hx_ref = w * Jx.transpose() * Jx;
+    const Eigen::Matrix<double, 6, 3> W_ref = w * Jp.transpose() * Jx;
+    const Eigen::Matrix3d BR = B * T.rotation();
+    Eigen::Matrix<double, 6, 3> W;
+    W.topRows<3>() = BR;
+    for (int j = 0; j < 3; ++j) W.block<3, 1>(3, j) = Xc.cross(BR.col(j));
+    ASSERT_LT((H - H_ref).norm(), 1e-12 * H_ref.norm()) << i;
+    ASSERT_LT((g - g_ref).norm(), 1e-12 * std::max(g_ref.norm(), 1e-300)) << i;
+    ASSERT_LT((T.rotation().transpose() * BR - Hx_ref).norm(), 1e-12 * Hx_ref.norm()) << i;
+    ASSERT_LT((T.rotation().transpose() * a - w * Jx.transpose() * r).norm(),
+              1e-12 * std::max(g_ref.norm(), 1e-300)) << i;
+    ASSERT_LT((W - W_ref).norm(), 1e-12 * W_ref.norm()) << i;
+  }
+}
+
 TEST(Jacobians, BehindCameraIsReported) {
   const auto cam = test::kitti_like_camera();
   Eigen::Vector3d r;

@@ -135,6 +135,35 @@ bool residual(const Context& c, const StereoLineObservation& o, double info, con
   return true;
 }
 
+// A point observation linearised through its projection Jacobian A = d(projection)/d(X_c):
+// J_pose = A [I, -hat(X_c)] and J_point = A R, so with B = w A'A and a = w A'r every block of the
+// normal equations is a 3x3 product or a few cross products (add_pose_normal_equations):
+//   J_point' w J_point = R' B R,   J_point' w r = R' a,   W = J_pose' w J_point = [BR; X_c x BR].
+// The weight w (information times the Huber weight) is one scalar for the three rows.
+struct PointLinearization {
+  Eigen::Matrix3d B, BR;
+  Eigen::Vector3d a, Xc;
+};
+
+bool linearize_point(const Context& c, const StereoPointObservation& o, double info, const SE3& T,
+                     const Eigen::Vector3d& X, double* rho, PointLinearization* lin) {
+  lin->Xc = T * X;
+  if (!(lin->Xc.z() > 0.0)) return false;
+  const Eigen::Vector3d r = stereo_point_residual_at(c.cam, lin->Xc, o.measurement, o.has_right);
+  const double s = info * r.squaredNorm();
+  const Huber h{o.has_right ? c.opt.chi2_point_stereo : c.opt.chi2_point_mono};
+  *rho = c.robust ? h.rho(s) : s;
+  const double w = info * (c.robust ? h.weight(s) : 1.0);
+  stereo_point_weighted_normal(c.cam, lin->Xc, r, o.has_right, w, &lin->B, &lin->a);
+  // B R with B(0,1) = B(1,0) = 0.
+  const Eigen::Matrix3d& Rm = T.rotation();
+  const Eigen::Matrix3d& B = lin->B;
+  lin->BR.row(0) = B(0, 0) * Rm.row(0) + B(0, 2) * Rm.row(2);
+  lin->BR.row(1) = B(1, 1) * Rm.row(1) + B(1, 2) * Rm.row(2);
+  lin->BR.row(2) = B(2, 0) * Rm.row(0) + B(2, 1) * Rm.row(1) + B(2, 2) * Rm.row(2);
+  return true;
+}
+
 // Where the two landmark kinds differ: their arrays in the problem and in the state.
 struct PointKind {
   static constexpr int R = 3, N = 3;
@@ -409,24 +438,41 @@ void SchurLm::linearize_slot(Groups<Kind>& G, int i, const std::vector<SE3>& pos
   auto& g = G.g_next[si];
   H.setZero();
   g.setZero();
-  Linearization<R, N> lin;
   for (int k = G.begin[si]; k < G.begin[si + 1]; ++k) {
     const ObsRef& ref = G.refs[static_cast<std::size_t>(k)];
+    const SE3& T = poses[static_cast<std::size_t>(ref.kf)];
     double rho = 0.0;
-    if (!residual(ctx_, obs[static_cast<std::size_t>(ref.obs)], ref.info,
-                  poses[static_cast<std::size_t>(ref.kf)], X, &rho, &lin)) {
-      ++acc.failures;
-      continue;
+    if constexpr (std::is_same_v<Kind, PointKind>) {
+      PointLinearization lin;
+      if (!linearize_point(ctx_, obs[static_cast<std::size_t>(ref.obs)], ref.info, T, X, &rho, &lin)) {
+        ++acc.failures;
+        continue;
+      }
+      acc.rho += rho;
+      H.noalias() += T.rotation().transpose().lazyProduct(lin.BR);
+      g.noalias() += T.rotation().transpose() * lin.a;
+      if (ref.cam < 0) continue;
+      add_pose_normal_equations(lin.B, lin.a, lin.Xc, acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam),
+                                acc.g.template segment<6>(6 * ref.cam));
+      auto& W = G.W_next[static_cast<std::size_t>(k)];
+      W.template topRows<3>() = lin.BR;
+      for (int j = 0; j < 3; ++j) W.template block<3, 1>(3, j) = lin.Xc.cross(lin.BR.col(j));
+    } else {
+      Linearization<R, N> lin;
+      if (!residual(ctx_, obs[static_cast<std::size_t>(ref.obs)], ref.info, T, X, &rho, &lin)) {
+        ++acc.failures;
+        continue;
+      }
+      acc.rho += rho;
+      const Eigen::Matrix<double, N, R> JlTw = lin.Jl.transpose() * lin.w.asDiagonal();
+      H.noalias() += JlTw * lin.Jl;
+      g.noalias() += JlTw * lin.r;
+      if (ref.cam < 0) continue;
+      const Eigen::Matrix<double, 6, R> JcTw = lin.Jc.transpose() * lin.w.asDiagonal();
+      acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam).noalias() += JcTw * lin.Jc;
+      acc.g.template segment<6>(6 * ref.cam).noalias() += JcTw * lin.r;
+      G.W_next[static_cast<std::size_t>(k)].noalias() = JcTw * lin.Jl;
     }
-    acc.rho += rho;
-    const Eigen::Matrix<double, N, R> JlTw = lin.Jl.transpose() * lin.w.asDiagonal();
-    H.noalias() += JlTw * lin.Jl;
-    g.noalias() += JlTw * lin.r;
-    if (ref.cam < 0) continue;
-    const Eigen::Matrix<double, 6, R> JcTw = lin.Jc.transpose() * lin.w.asDiagonal();
-    acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam).noalias() += JcTw * lin.Jc;
-    acc.g.template segment<6>(6 * ref.cam).noalias() += JcTw * lin.r;
-    G.W_next[static_cast<std::size_t>(k)].noalias() = JcTw * lin.Jl;
   }
 }
 
@@ -437,17 +483,30 @@ void SchurLm::linearize_fixed(const Groups<Kind>& G, int k, const std::vector<SE
   const ObsRef& ref = G.fixed[static_cast<std::size_t>(k)];
   const auto& o = Kind::observations(p_)[static_cast<std::size_t>(ref.obs)];
   const auto& X = Kind::values(*s_)[static_cast<std::size_t>(Kind::landmark(o))];
-  Linearization<R, N> lin;
+  const SE3& T = poses[static_cast<std::size_t>(ref.kf)];
   double rho = 0.0;
-  if (!residual(ctx_, o, ref.info, poses[static_cast<std::size_t>(ref.kf)], X, &rho, &lin)) {
-    ++acc.failures;
-    return;
+  if constexpr (std::is_same_v<Kind, PointKind>) {
+    PointLinearization lin;
+    if (!linearize_point(ctx_, o, ref.info, T, X, &rho, &lin)) {
+      ++acc.failures;
+      return;
+    }
+    acc.rho += rho;
+    if (ref.cam < 0) return;
+    add_pose_normal_equations(lin.B, lin.a, lin.Xc, acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam),
+                              acc.g.template segment<6>(6 * ref.cam));
+  } else {
+    Linearization<R, N> lin;
+    if (!residual(ctx_, o, ref.info, T, X, &rho, &lin)) {
+      ++acc.failures;
+      return;
+    }
+    acc.rho += rho;
+    if (ref.cam < 0) return;
+    const Eigen::Matrix<double, 6, R> JcTw = lin.Jc.transpose() * lin.w.asDiagonal();
+    acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam).noalias() += JcTw * lin.Jc;
+    acc.g.template segment<6>(6 * ref.cam).noalias() += JcTw * lin.r;
   }
-  acc.rho += rho;
-  if (ref.cam < 0) return;
-  const Eigen::Matrix<double, 6, R> JcTw = lin.Jc.transpose() * lin.w.asDiagonal();
-  acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam).noalias() += JcTw * lin.Jc;
-  acc.g.template segment<6>(6 * ref.cam).noalias() += JcTw * lin.r;
 }
 
 double SchurLm::linearize(const std::vector<SE3>& poses, bool with_step) {
