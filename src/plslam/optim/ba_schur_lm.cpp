@@ -29,6 +29,7 @@
 
 #include "plslam/optim/ba_pass.h"
 #include "plslam/optim/robust.h"
+#include "plslam/optim/schur_kernel.h"
 #include "plslam/optim/stereo_line_residual.h"
 #include "plslam/optim/stereo_point_residual.h"
 
@@ -292,12 +293,14 @@ struct Accumulator {
   // W L^-1 per ref of the landmark being eliminated (points, lines).
   std::vector<Eigen::Matrix<double, 6, 3>> Y3;
   std::vector<Eigen::Matrix<double, 6, 6>> Y6;
+  std::vector<int> cams;  // camera slot per ref of that landmark
 
   Accumulator(int n_cams, int max_group)
       : H(Eigen::MatrixXd::Zero(6 * n_cams, 6 * n_cams)),
         g(Eigen::VectorXd::Zero(6 * n_cams)),
         Y3(static_cast<std::size_t>(max_group)),
-        Y6(static_cast<std::size_t>(max_group)) {}
+        Y6(static_cast<std::size_t>(max_group)),
+        cams(static_cast<std::size_t>(max_group)) {}
   auto& scratch(std::integral_constant<int, 3>) { return Y3; }
   auto& scratch(std::integral_constant<int, 6>) { return Y6; }
   void add(const Accumulator& o) {
@@ -374,6 +377,7 @@ class SchurLm {
   const BaPassSpec& spec_;
   BaState* s_;
   int threads_;
+  SchurKernelImpl kernel_ = best_schur_kernel();
   mutable std::unique_ptr<tbb::task_arena> arena_;  // execute() is non-const
 
   std::vector<int> cam_of_kf_;
@@ -540,32 +544,19 @@ void SchurLm::eliminate_slot(Groups<Kind>& G, int i, double lambda, Accumulator&
   const auto& Hinv = G.Hinv[si];
   const int b = G.begin[si], e = G.begin[si + 1];
   auto& Ys = acc.scratch(std::integral_constant<int, N>());
-  // Y_a = W_a L^-1, then S -= Y_a W_c' for c >= a (upper block triangle), products written
-  // straight into S.
+  // Y_a = W_a L^-1 once per observation; the kernel then subtracts Y_a W_c' for every pair
+  // into the upper block triangle of S.
   for (int a = b; a < e; ++a) {
     const ObsRef& ra = G.refs[static_cast<std::size_t>(a)];
+    acc.cams[static_cast<std::size_t>(a - b)] = ra.cam;
     if (ra.cam < 0) continue;
     auto& Y = Ys[static_cast<std::size_t>(a - b)];
-    Y.noalias() = G.W[static_cast<std::size_t>(a)] * Hinv;
+    Y.noalias() = G.W[static_cast<std::size_t>(a)].lazyProduct(Hinv);
     acc.g.template segment<6>(6 * ra.cam).noalias() -= Y * G.g[si];
   }
-  for (int a = b; a < e; ++a) {
-    const int ca = G.refs[static_cast<std::size_t>(a)].cam;
-    if (ca < 0) continue;
-    const auto& Ya = Ys[static_cast<std::size_t>(a - b)];
-    const auto& Wa = G.W[static_cast<std::size_t>(a)];
-    for (int c = a; c < e; ++c) {
-      const int cc = G.refs[static_cast<std::size_t>(c)].cam;
-      if (cc < 0) continue;
-      if (ca <= cc) {
-        acc.H.block<6, 6>(6 * ca, 6 * cc).noalias() -= Ya * G.W[static_cast<std::size_t>(c)].transpose();
-      } else {  // (Y_a W_c')' = Y_c W_a' since W L^-1 W' is symmetric
-        acc.H.block<6, 6>(6 * cc, 6 * ca).noalias() -= Ys[static_cast<std::size_t>(c - b)] * Wa.transpose();
-      }
-      if (ca == cc && a != c) {  // the same keyframe observes the landmark twice: both orders
-        acc.H.block<6, 6>(6 * ca, 6 * ca).noalias() -= Ys[static_cast<std::size_t>(c - b)] * Wa.transpose();
-      }
-    }
+  if (e > b) {
+    schur_landmark_update(kernel_, N, e - b, acc.cams.data(), Ys.front().data(),
+                          G.W[static_cast<std::size_t>(b)].data(), acc.H.data(), acc.H.rows());
   }
 }
 
