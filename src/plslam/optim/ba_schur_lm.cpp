@@ -144,24 +144,32 @@ bool residual(const Context& c, const StereoLineObservation& o, double info, con
 struct PointLinearization {
   Eigen::Matrix3d B, BR;
   Eigen::Vector3d a, Xc;
+  double rho;
 };
 
-bool linearize_point(const Context& c, const StereoPointObservation& o, double info, const SE3& T,
-                     const Eigen::Vector3d& X, double* rho, PointLinearization* lin) {
-  lin->Xc = T * X;
-  if (!(lin->Xc.z() > 0.0)) return false;
-  const Eigen::Vector3d r = stereo_point_residual_at(c.cam, lin->Xc, o.measurement, o.has_right);
+// False when the point is behind the camera. Inlined into its two callers and written on locals
+// (no output pointers that could alias X_c), so X_c, 1/z and B stay in registers.
+[[gnu::always_inline]] inline bool linearize_point(const Context& c, const StereoPointObservation& o,
+                                                   double info, const SE3& T,
+                                                   const Eigen::Vector3d& X, PointLinearization& lin) {
+  const Eigen::Vector3d Xc = T * X;
+  if (!(Xc.z() > 0.0)) return false;
+  const Eigen::Vector3d r = stereo_point_residual_at(c.cam, Xc, o.measurement, o.has_right);
   const double s = info * r.squaredNorm();
   const Huber h{o.has_right ? c.opt.chi2_point_stereo : c.opt.chi2_point_mono};
-  *rho = c.robust ? h.rho(s) : s;
+  lin.rho = c.robust ? h.rho(s) : s;
   const double w = info * (c.robust ? h.weight(s) : 1.0);
-  stereo_point_weighted_normal(c.cam, lin->Xc, r, o.has_right, w, &lin->B, &lin->a);
+  Eigen::Matrix3d B;
+  Eigen::Vector3d a;
+  stereo_point_weighted_normal(c.cam, Xc, r, o.has_right, w, &B, &a);
   // B R with B(0,1) = B(1,0) = 0.
   const Eigen::Matrix3d& Rm = T.rotation();
-  const Eigen::Matrix3d& B = lin->B;
-  lin->BR.row(0) = B(0, 0) * Rm.row(0) + B(0, 2) * Rm.row(2);
-  lin->BR.row(1) = B(1, 1) * Rm.row(1) + B(1, 2) * Rm.row(2);
-  lin->BR.row(2) = B(2, 0) * Rm.row(0) + B(2, 1) * Rm.row(1) + B(2, 2) * Rm.row(2);
+  lin.BR.row(0) = B(0, 0) * Rm.row(0) + B(0, 2) * Rm.row(2);
+  lin.BR.row(1) = B(1, 1) * Rm.row(1) + B(1, 2) * Rm.row(2);
+  lin.BR.row(2) = B(2, 0) * Rm.row(0) + B(2, 1) * Rm.row(1) + B(2, 2) * Rm.row(2);
+  lin.B = B;
+  lin.a = a;
+  lin.Xc = Xc;
   return true;
 }
 
@@ -445,14 +453,13 @@ void SchurLm::linearize_slot(Groups<Kind>& G, int i, const std::vector<SE3>& pos
   for (int k = G.begin[si]; k < G.begin[si + 1]; ++k) {
     const ObsRef& ref = G.refs[static_cast<std::size_t>(k)];
     const SE3& T = poses[static_cast<std::size_t>(ref.kf)];
-    double rho = 0.0;
     if constexpr (std::is_same_v<Kind, PointKind>) {
       PointLinearization lin;
-      if (!linearize_point(ctx_, obs[static_cast<std::size_t>(ref.obs)], ref.info, T, X, &rho, &lin)) {
+      if (!linearize_point(ctx_, obs[static_cast<std::size_t>(ref.obs)], ref.info, T, X, lin)) {
         ++acc.failures;
         continue;
       }
-      acc.rho += rho;
+      acc.rho += lin.rho;
       H.noalias() += T.rotation().transpose().lazyProduct(lin.BR);
       g.noalias() += T.rotation().transpose() * lin.a;
       if (ref.cam < 0) continue;
@@ -463,6 +470,7 @@ void SchurLm::linearize_slot(Groups<Kind>& G, int i, const std::vector<SE3>& pos
       for (int j = 0; j < 3; ++j) W.template block<3, 1>(3, j) = lin.Xc.cross(lin.BR.col(j));
     } else {
       Linearization<R, N> lin;
+      double rho = 0.0;
       if (!residual(ctx_, obs[static_cast<std::size_t>(ref.obs)], ref.info, T, X, &rho, &lin)) {
         ++acc.failures;
         continue;
@@ -488,19 +496,19 @@ void SchurLm::linearize_fixed(const Groups<Kind>& G, int k, const std::vector<SE
   const auto& o = Kind::observations(p_)[static_cast<std::size_t>(ref.obs)];
   const auto& X = Kind::values(*s_)[static_cast<std::size_t>(Kind::landmark(o))];
   const SE3& T = poses[static_cast<std::size_t>(ref.kf)];
-  double rho = 0.0;
   if constexpr (std::is_same_v<Kind, PointKind>) {
     PointLinearization lin;
-    if (!linearize_point(ctx_, o, ref.info, T, X, &rho, &lin)) {
+    if (!linearize_point(ctx_, o, ref.info, T, X, lin)) {
       ++acc.failures;
       return;
     }
-    acc.rho += rho;
+    acc.rho += lin.rho;
     if (ref.cam < 0) return;
     add_pose_normal_equations(lin.B, lin.a, lin.Xc, acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam),
                               acc.g.template segment<6>(6 * ref.cam));
   } else {
     Linearization<R, N> lin;
+    double rho = 0.0;
     if (!residual(ctx_, o, ref.info, T, X, &rho, &lin)) {
       ++acc.failures;
       return;
