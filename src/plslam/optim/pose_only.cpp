@@ -28,25 +28,23 @@ double evaluate(const Problem& p, const SE3& T, const std::vector<bool>& point_o
                 const std::vector<bool>& line_out, bool robust, Matrix6d* H, Vector6d* g) {
   double cost = 0.0;
   const bool jac = H != nullptr;
-  Eigen::Vector3d r;
-  Matrix36d J;
   for (std::size_t i = 0; i < p.points.size(); ++i) {
     if (point_out[i]) continue;
     const auto& t = p.points[i];
-    if (!evaluate_stereo_point(p.cam, T, t.world, t.obs.measurement, t.obs.has_right, &r,
-                               jac ? &J : nullptr, nullptr)) {
-      continue;  // behind the camera: contributes nothing this iteration
-    }
+    const Eigen::Vector3d Xc = T * t.world;
+    if (!(Xc.z() > 0.0)) continue;  // behind the camera: contributes nothing this iteration
+    const Eigen::Vector3d r = stereo_point_residual_at(p.cam, Xc, t.obs.measurement, t.obs.has_right);
     const double info = p.point_info[i];
     const double s = info * r.squaredNorm();
     const Huber h{t.obs.has_right ? p.opt.chi2_point_stereo : p.opt.chi2_point_mono};
     cost += robust ? h.rho(s) : s;
     if (jac) {
+      // w J'J and w J'r from the projection Jacobian's structure (stereo_point_residual.h).
       const double w = info * (robust ? h.weight(s) : 1.0);
-      // Fixed-size products (rankUpdate on a 6x3 takes Eigen's slow general-product path).
-      const Eigen::Matrix<double, 6, 3> wJt = w * J.transpose();
-      H->noalias() += wJt.lazyProduct(J);
-      g->noalias() += wJt * r;
+      Eigen::Matrix3d B;
+      Eigen::Vector3d a;
+      stereo_point_weighted_normal(p.cam, Xc, r, t.obs.has_right, w, &B, &a);
+      add_pose_normal_equations(B, a, Xc, *H, *g);
     }
   }
   Eigen::Vector4d rl;
@@ -168,6 +166,9 @@ PoseOnlyResult optimize_pose(const geometry::StereoCamera& cam, const SE3& T_cw_
         // Converged: a sub-micrometre / sub-microradian step or a negligible cost decrease.
         if (delta.squaredNorm() < 1e-12 || old_cost - new_cost < 1e-9 * old_cost) break;
       } else {
+        // A sub-micrometre / sub-microradian step that does not lower the cost: at the optimum,
+        // where the cost change is rounding noise, more damping would only repeat it.
+        if (delta.squaredNorm() < 1e-12) break;
         lambda *= 4.0;
         if (lambda > 1e8) break;
       }
