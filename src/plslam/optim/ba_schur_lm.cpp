@@ -79,15 +79,6 @@ bool invert_spd(const Matrix6d& A, Matrix6d* inv) {
   return true;
 }
 
-// One observation linearised: R residual rows, N landmark parameters; w holds the IRLS weight
-// (information included) of each row.
-template <int R, int N>
-struct Linearization {
-  Eigen::Matrix<double, R, 1> r, w;
-  Eigen::Matrix<double, R, 6> Jc;
-  Eigen::Matrix<double, R, N> Jl;
-};
-
 struct Context {
   const geometry::StereoCamera& cam;
   const BaOptions& opt;
@@ -96,29 +87,21 @@ struct Context {
 
 // Sum of rho over the observation's robust blocks; false when a point is behind the camera.
 bool residual(const Context& c, const StereoPointObservation& o, double info, const SE3& T,
-              const Eigen::Vector3d& X, double* rho, Linearization<3, 3>* lin) {
+              const Eigen::Vector3d& X, double* rho) {
   Eigen::Vector3d r;
-  if (!evaluate_stereo_point(c.cam, T, X, o.measurement, o.has_right, &r,
-                             lin ? &lin->Jc : nullptr, lin ? &lin->Jl : nullptr)) {
+  if (!evaluate_stereo_point(c.cam, T, X, o.measurement, o.has_right, &r, nullptr, nullptr)) {
     return false;
   }
   const double s = info * r.squaredNorm();
   const Huber h{o.has_right ? c.opt.chi2_point_stereo : c.opt.chi2_point_mono};
   *rho = c.robust ? h.rho(s) : s;
-  if (lin) {
-    lin->r = r;
-    lin->w.setConstant(info * (c.robust ? h.weight(s) : 1.0));
-  }
   return true;
 }
 
 bool residual(const Context& c, const StereoLineObservation& o, double info, const SE3& T,
-              const Vector6d& L, double* rho, Linearization<4, 6>* lin) {
+              const Vector6d& L, double* rho) {
   Eigen::Vector4d r;
-  Matrix46d Jp;
-  Matrix43d Js, Je;
-  if (!evaluate_stereo_line(c.cam, T, L.head<3>(), L.tail<3>(), o, &r, lin ? &Jp : nullptr,
-                            lin ? &Js : nullptr, lin ? &Je : nullptr)) {
+  if (!evaluate_stereo_line(c.cam, T, L.head<3>(), L.tail<3>(), o, &r, nullptr, nullptr, nullptr)) {
     return false;
   }
   const Huber h{c.opt.chi2_line_pair};
@@ -126,12 +109,6 @@ bool residual(const Context& c, const StereoLineObservation& o, double info, con
   for (int pair = 0; pair < 2; ++pair) {  // left image rows 0-1, right image rows 2-3
     const double s = info * r.segment<2>(2 * pair).squaredNorm();
     *rho += c.robust ? h.rho(s) : s;
-    if (lin) lin->w.segment<2>(2 * pair).setConstant(info * (c.robust ? h.weight(s) : 1.0));
-  }
-  if (lin) {
-    lin->r = r;
-    lin->Jc = Jp;
-    lin->Jl << Js, Je;
   }
   return true;
 }
@@ -170,6 +147,37 @@ struct PointLinearization {
   lin.B = B;
   lin.a = a;
   lin.Xc = Xc;
+  return true;
+}
+
+// A line observation: each endpoint x is a point observation of its own (rows 0, 2 the start,
+// rows 1, 3 the end; stereo_line_weighted_normal), so the line's landmark block is
+// blockdiag(R' B_s R, R' B_e R) and W = [W_s, W_e] with W_x = [B_x R; X_x x B_x R].
+struct LineLinearization {
+  Eigen::Matrix3d B[2], BR[2];
+  Eigen::Vector3d a[2], Xc[2];
+  double rho;
+};
+
+[[gnu::always_inline]] inline bool linearize_line(const Context& c, const StereoLineObservation& o,
+                                                  double info, const SE3& T, const Vector6d& L,
+                                                  LineLinearization& lin) {
+  const Eigen::Vector3d Xs = T * Eigen::Vector3d(L.head<3>());
+  const Eigen::Vector3d Xe = T * Eigen::Vector3d(L.tail<3>());
+  if (!(Xs.z() > 0.0) || !(Xe.z() > 0.0)) return false;
+  const Eigen::Vector4d r = stereo_line_residual_at(c.cam, Xs, Xe, o);
+  const Huber h{c.opt.chi2_line_pair};
+  Eigen::Vector2d w;
+  lin.rho = 0.0;
+  for (int pair = 0; pair < 2; ++pair) {  // left image rows 0-1, right image rows 2-3
+    const double s = info * r.segment<2>(2 * pair).squaredNorm();
+    lin.rho += c.robust ? h.rho(s) : s;
+    w(pair) = info * (c.robust ? h.weight(s) : 1.0);
+  }
+  stereo_line_weighted_normal(c.cam, Xs, Xe, o, r, w, lin.B, lin.a);
+  for (int x = 0; x < 2; ++x) lin.BR[x].noalias() = lin.B[x].lazyProduct(T.rotation());
+  lin.Xc[0] = Xs;
+  lin.Xc[1] = Xe;
   return true;
 }
 
@@ -441,7 +449,6 @@ Accumulator SchurLm::accumulate(int n, const Body& body) const {
 template <class Kind>
 void SchurLm::linearize_slot(Groups<Kind>& G, int i, const std::vector<SE3>& poses,
                              bool with_step, Accumulator& acc) const {
-  constexpr int R = Kind::R, N = Kind::N;
   const auto si = static_cast<std::size_t>(i);
   const auto& obs = Kind::observations(p_);
   typename Kind::Vec X = Kind::values(*s_)[static_cast<std::size_t>(G.landmark[si])];
@@ -469,21 +476,27 @@ void SchurLm::linearize_slot(Groups<Kind>& G, int i, const std::vector<SE3>& pos
       W.template topRows<3>() = lin.BR;
       for (int j = 0; j < 3; ++j) W.template block<3, 1>(3, j) = lin.Xc.cross(lin.BR.col(j));
     } else {
-      Linearization<R, N> lin;
-      double rho = 0.0;
-      if (!residual(ctx_, obs[static_cast<std::size_t>(ref.obs)], ref.info, T, X, &rho, &lin)) {
+      LineLinearization lin;
+      if (!linearize_line(ctx_, obs[static_cast<std::size_t>(ref.obs)], ref.info, T, X, lin)) {
         ++acc.failures;
         continue;
       }
-      acc.rho += rho;
-      const Eigen::Matrix<double, N, R> JlTw = lin.Jl.transpose() * lin.w.asDiagonal();
-      H.noalias() += JlTw * lin.Jl;
-      g.noalias() += JlTw * lin.r;
+      acc.rho += lin.rho;
+      for (int x = 0; x < 2; ++x) {
+        H.template block<3, 3>(3 * x, 3 * x).noalias() += T.rotation().transpose().lazyProduct(lin.BR[x]);
+        g.template segment<3>(3 * x).noalias() += T.rotation().transpose() * lin.a[x];
+      }
       if (ref.cam < 0) continue;
-      const Eigen::Matrix<double, 6, R> JcTw = lin.Jc.transpose() * lin.w.asDiagonal();
-      acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam).noalias() += JcTw * lin.Jc;
-      acc.g.template segment<6>(6 * ref.cam).noalias() += JcTw * lin.r;
-      G.W_next[static_cast<std::size_t>(k)].noalias() = JcTw * lin.Jl;
+      auto& W = G.W_next[static_cast<std::size_t>(k)];
+      for (int x = 0; x < 2; ++x) {
+        add_pose_normal_equations(lin.B[x], lin.a[x], lin.Xc[x],
+                                  acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam),
+                                  acc.g.template segment<6>(6 * ref.cam));
+        W.template block<3, 3>(0, 3 * x) = lin.BR[x];
+        for (int j = 0; j < 3; ++j) {
+          W.template block<3, 1>(3, 3 * x + j) = lin.Xc[x].cross(lin.BR[x].col(j));
+        }
+      }
     }
   }
 }
@@ -491,7 +504,6 @@ void SchurLm::linearize_slot(Groups<Kind>& G, int i, const std::vector<SE3>& pos
 template <class Kind>
 void SchurLm::linearize_fixed(const Groups<Kind>& G, int k, const std::vector<SE3>& poses,
                               Accumulator& acc) const {
-  constexpr int R = Kind::R, N = Kind::N;
   const ObsRef& ref = G.fixed[static_cast<std::size_t>(k)];
   const auto& o = Kind::observations(p_)[static_cast<std::size_t>(ref.obs)];
   const auto& X = Kind::values(*s_)[static_cast<std::size_t>(Kind::landmark(o))];
@@ -507,17 +519,18 @@ void SchurLm::linearize_fixed(const Groups<Kind>& G, int k, const std::vector<SE
     add_pose_normal_equations(lin.B, lin.a, lin.Xc, acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam),
                               acc.g.template segment<6>(6 * ref.cam));
   } else {
-    Linearization<R, N> lin;
-    double rho = 0.0;
-    if (!residual(ctx_, o, ref.info, T, X, &rho, &lin)) {
+    LineLinearization lin;
+    if (!linearize_line(ctx_, o, ref.info, T, X, lin)) {
       ++acc.failures;
       return;
     }
-    acc.rho += rho;
+    acc.rho += lin.rho;
     if (ref.cam < 0) return;
-    const Eigen::Matrix<double, 6, R> JcTw = lin.Jc.transpose() * lin.w.asDiagonal();
-    acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam).noalias() += JcTw * lin.Jc;
-    acc.g.template segment<6>(6 * ref.cam).noalias() += JcTw * lin.r;
+    for (int x = 0; x < 2; ++x) {
+      add_pose_normal_equations(lin.B[x], lin.a[x], lin.Xc[x],
+                                acc.H.template block<6, 6>(6 * ref.cam, 6 * ref.cam),
+                                acc.g.template segment<6>(6 * ref.cam));
+    }
   }
 }
 
@@ -666,20 +679,18 @@ BaExclusions SchurLm::exclusions_with_invalid() const {
   ex.point_out.assign(p_.point_observations.size(), false);
   ex.line_out.assign(p_.line_observations.size(), false);
   if (spec_.excluded) ex = *spec_.excluded;
-  Linearization<3, 3>* no_point = nullptr;
-  Linearization<4, 6>* no_line = nullptr;
   double rho = 0.0;
   for (std::size_t k = 0; k < p_.point_observations.size(); ++k) {
     const auto& o = p_.point_observations[k];
     ex.point_out[k] = ex.point_out[k] ||
                       !residual(ctx_, o, 1.0, s_->poses[static_cast<std::size_t>(o.keyframe)],
-                                s_->points[static_cast<std::size_t>(o.point)], &rho, no_point);
+                                s_->points[static_cast<std::size_t>(o.point)], &rho);
   }
   for (std::size_t k = 0; k < p_.line_observations.size(); ++k) {
     const auto& o = p_.line_observations[k];
     ex.line_out[k] = ex.line_out[k] ||
                      !residual(ctx_, o, 1.0, s_->poses[static_cast<std::size_t>(o.keyframe)],
-                               s_->lines[static_cast<std::size_t>(o.line)], &rho, no_line);
+                               s_->lines[static_cast<std::size_t>(o.line)], &rho);
   }
   return ex;
 }

@@ -32,6 +32,18 @@ inline Eigen::RowVector3d line_point_gradient(const geometry::StereoCamera& cam,
 // Returns false (outputs untouched) when an endpoint is not in front of the camera. J_pose is
 // w.r.t. the left perturbation [rho; phi] of T_cw, J_start / J_end w.r.t. the world endpoints
 // (rows 1, 3 of J_start and rows 0, 2 of J_end are zero). Null Jacobian pointers are skipped.
+// The 4 residuals at camera endpoints with positive depth.
+inline Eigen::Vector4d stereo_line_residual_at(const geometry::StereoCamera& cam,
+                                               const Eigen::Vector3d& Xs, const Eigen::Vector3d& Xe,
+                                               const StereoLineObservation& obs) {
+  const Eigen::Vector3d ps = cam.project_stereo(Xs);
+  const Eigen::Vector3d pe = cam.project_stereo(Xe);
+  const Eigen::Vector3d& lL = obs.left_line;
+  const Eigen::Vector3d& lR = obs.right_line;
+  return {lL(0) * ps(0) + lL(1) * ps(1) + lL(2), lL(0) * pe(0) + lL(1) * pe(1) + lL(2),
+          lR(0) * ps(2) + lR(1) * ps(1) + lR(2), lR(0) * pe(2) + lR(1) * pe(1) + lR(2)};
+}
+
 inline bool evaluate_stereo_line(const geometry::StereoCamera& cam, const geometry::SE3& T_cw,
                                  const Eigen::Vector3d& Ps, const Eigen::Vector3d& Pe,
                                  const StereoLineObservation& obs, Eigen::Vector4d* r,
@@ -39,14 +51,9 @@ inline bool evaluate_stereo_line(const geometry::StereoCamera& cam, const geomet
   const Eigen::Vector3d Xs = T_cw * Ps;
   const Eigen::Vector3d Xe = T_cw * Pe;
   if (!(Xs.z() > 0.0) || !(Xe.z() > 0.0)) return false;
-  const Eigen::Vector3d ps = cam.project_stereo(Xs);
-  const Eigen::Vector3d pe = cam.project_stereo(Xe);
+  *r = stereo_line_residual_at(cam, Xs, Xe, obs);
   const Eigen::Vector3d& lL = obs.left_line;
   const Eigen::Vector3d& lR = obs.right_line;
-  (*r)(0) = lL(0) * ps(0) + lL(1) * ps(1) + lL(2);
-  (*r)(1) = lL(0) * pe(0) + lL(1) * pe(1) + lL(2);
-  (*r)(2) = lR(0) * ps(2) + lR(1) * ps(1) + lR(2);
-  (*r)(3) = lR(0) * pe(2) + lR(1) * pe(1) + lR(2);
   if (!J_pose && !J_start && !J_end) return true;
   Eigen::Matrix<double, 4, 3> Gs = Eigen::Matrix<double, 4, 3>::Zero();  // d r / d X_s
   Eigen::Matrix<double, 4, 3> Ge = Eigen::Matrix<double, 4, 3>::Zero();  // d r / d X_e
@@ -63,6 +70,27 @@ inline bool evaluate_stereo_line(const geometry::StereoCamera& cam, const geomet
   if (J_start) *J_start = Gs * R;
   if (J_end) *J_end = Ge * R;
   return true;
+}
+
+// Each endpoint enters two residuals, one per image (rows 0, 2 the start, rows 1, 3 the end), with
+// d r / d X = G_x [I, -hat(X_x)] for the pose and G_x R for the endpoint, G_x the 2x3 stack of its
+// left and right line_point_gradient. So an endpoint is a point observation with
+//   B_x = G_x' diag(w_left, w_right) G_x,   a_x = G_x' diag(w_left, w_right) (r_left, r_right)
+// (add_pose_normal_equations), and the line's landmark block is block diagonal (start, end).
+// w = (w_left, w_right): the weights of the two image pairs. Index 0 start, 1 end.
+inline void stereo_line_weighted_normal(const geometry::StereoCamera& cam, const Eigen::Vector3d& Xs,
+                                        const Eigen::Vector3d& Xe, const StereoLineObservation& obs,
+                                        const Eigen::Vector4d& r, const Eigen::Vector2d& w,
+                                        Eigen::Matrix3d B[2], Eigen::Vector3d a[2]) {
+  for (int x = 0; x < 2; ++x) {
+    const Eigen::Vector3d& X = x == 0 ? Xs : Xe;
+    const Eigen::Vector3d gl = detail::line_point_gradient(cam, obs.left_line, X, false).transpose();
+    const Eigen::Vector3d gr = detail::line_point_gradient(cam, obs.right_line, X, true).transpose();
+    const Eigen::Vector3d wgl = w(0) * gl, wgr = w(1) * gr;
+    B[x].noalias() = wgl * gl.transpose();
+    B[x].noalias() += wgr * gr.transpose();
+    a[x] = wgl * r(x) + wgr * r(2 + x);
+  }
 }
 
 }  // namespace plslam::optim
