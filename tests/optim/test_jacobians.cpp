@@ -301,6 +301,53 @@ TEST(Jacobians, StereoPointNormalEquationsFromStructure) {
   }
 }
 
+// The same for a line observation: each endpoint as a weighted 2-row point observation.
+TEST(Jacobians, StereoLineNormalEquationsFromStructure) {
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> weight(0.05, 3.0);
+  for (int i = 0; i < kConfigs; ++i) {
+    const SE3 T = test::random_pose(rng, 5.0, 1.0);
+    const auto [Ps, Pe] = test::random_segment(cam, T, rng);
+    const StereoLineObservation o = test::observe_line(cam, T, Ps, Pe, 2.0, rng);
+    const Eigen::Vector2d w(weight(rng), weight(rng));
+    Eigen::Vector4d r;
+    Matrix46d Jp;
+    Matrix43d Js, Je;
+    ASSERT_TRUE(evaluate_stereo_line(cam, T, Ps, Pe, o, &r, &Jp, &Js, &Je));
+    const Eigen::Vector3d Xs = T * Ps, Xe = T * Pe;
+    EXPECT_EQ((stereo_line_residual_at(cam, Xs, Xe, o) - r).norm(), 0.0);
+    Eigen::Matrix3d B[2];
+    Eigen::Vector3d a[2];
+    stereo_line_weighted_normal(cam, Xs, Xe, o, r, w, B, a);
+    geometry::Matrix6d H = geometry::Matrix6d::Zero();
+    Vector6d g = Vector6d::Zero();
+    add_pose_normal_equations(B[0], a[0], Xs, H, g);
+    add_pose_normal_equations(B[1], a[1], Xe, H, g);
+    const Eigen::Vector4d wr(w(0), w(0), w(1), w(1));
+    const geometry::Matrix6d H_ref = Jp.transpose() * wr.asDiagonal() * Jp;
+    const Vector6d g_ref = Jp.transpose() * wr.asDiagonal() * r;
+    ASSERT_LT((H - H_ref).norm(), 1e-12 * H_ref.norm()) << i;
+    ASSERT_LT((g - g_ref).norm(), 1e-12 * std::max(g_ref.norm(), 1e-300)) << i;
+    const Matrix43d* J[2] = {&Js, &Je};
+    const Eigen::Vector3d* Xc[2] = {&Xs, &Xe};
+    for (int x = 0; x < 2; ++x) {
+      const Eigen::Matrix3d Hx_ref = J[x]->transpose() * wr.asDiagonal() * *J[x];
+      const Eigen::Matrix<double, 6, 3> W_ref = Jp.transpose() * wr.asDiagonal() * *J[x];
+      const Eigen::Matrix3d BR = B[x] * T.rotation();
+      Eigen::Matrix<double, 6, 3> W;
+      W.topRows<3>() = BR;
+      for (int j = 0; j < 3; ++j) W.block<3, 1>(3, j) = Xc[x]->cross(BR.col(j));
+      ASSERT_LT((T.rotation().transpose() * BR - Hx_ref).norm(), 1e-12 * Hx_ref.norm()) << i;
+      ASSERT_LT((T.rotation().transpose() * a[x] - J[x]->transpose() * wr.asDiagonal() * r).norm(),
+                1e-12 * std::max(g_ref.norm(), 1e-300)) << i;
+      ASSERT_LT((W - W_ref).norm(), 1e-12 * W_ref.norm()) << i;
+    }
+    // The endpoints do not couple: J_start' w J_end is zero.
+    EXPECT_EQ((Js.transpose() * wr.asDiagonal() * Je).norm(), 0.0);
+  }
+}
+
 TEST(Jacobians, BehindCameraIsReported) {
   const auto cam = test::kitti_like_camera();
   Eigen::Vector3d r;
