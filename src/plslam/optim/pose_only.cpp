@@ -47,29 +47,28 @@ double evaluate(const Problem& p, const SE3& T, const std::vector<bool>& point_o
       add_pose_normal_equations(B, a, Xc, *H, *g);
     }
   }
-  Eigen::Vector4d rl;
-  Matrix46d Jl;
   const Huber hl{p.opt.chi2_line_pair};
   for (std::size_t i = 0; i < p.lines.size(); ++i) {
     if (line_out[i]) continue;
     const auto& t = p.lines[i];
-    if (!evaluate_stereo_line(p.cam, T, t.start, t.end, t.obs, &rl, jac ? &Jl : nullptr, nullptr,
-                              nullptr)) {
-      continue;
-    }
+    const Eigen::Vector3d Xs = T * t.start, Xe = T * t.end;
+    if (!(Xs.z() > 0.0) || !(Xe.z() > 0.0)) continue;
+    const Eigen::Vector4d rl = stereo_line_residual_at(p.cam, Xs, Xe, t.obs);
     const double info = p.line_info[i];
     // Two independent Huber pairs: left image rows 0-1, right image rows 2-3.
+    Eigen::Vector2d w;
     for (int pair = 0; pair < 2; ++pair) {
-      const auto rp = rl.segment<2>(2 * pair);
-      const double s = info * rp.squaredNorm();
+      const double s = info * rl.segment<2>(2 * pair).squaredNorm();
       cost += robust ? hl.rho(s) : s;
-      if (jac) {
-        const double w = info * (robust ? hl.weight(s) : 1.0);
-        const Eigen::Matrix<double, 2, 6> Jp = Jl.middleRows<2>(2 * pair);
-        const Eigen::Matrix<double, 6, 2> wJt = w * Jp.transpose();
-        H->noalias() += wJt.lazyProduct(Jp);
-        g->noalias() += wJt * rp;
-      }
+      w(pair) = info * (robust ? hl.weight(s) : 1.0);
+    }
+    if (jac) {
+      // Each endpoint as a weighted 2-row point observation (stereo_line_residual.h).
+      Eigen::Matrix3d B[2];
+      Eigen::Vector3d a[2];
+      stereo_line_weighted_normal(p.cam, Xs, Xe, t.obs, rl, w, B, a);
+      add_pose_normal_equations(B[0], a[0], Xs, *H, *g);
+      add_pose_normal_equations(B[1], a[1], Xe, *H, *g);
     }
   }
   return cost;
