@@ -124,9 +124,9 @@ struct PointLinearization {
   double rho;
 };
 
-// False when the point is behind the camera. Inlined into its two callers and written on locals
-// (no output pointers that could alias X_c), so X_c, 1/z and B stay in registers.
-[[gnu::always_inline]] inline bool linearize_point(const Context& c, const StereoPointObservation& o,
+// False when the point is behind the camera. Written on locals (no output pointers that could
+// alias X_c), so 1/z is computed once. Forcing it inline was measured slower (code size).
+bool linearize_point(const Context& c, const StereoPointObservation& o,
                                                    double info, const SE3& T,
                                                    const Eigen::Vector3d& X, PointLinearization& lin) {
   const Eigen::Vector3d Xc = T * X;
@@ -159,7 +159,7 @@ struct LineLinearization {
   double rho;
 };
 
-[[gnu::always_inline]] inline bool linearize_line(const Context& c, const StereoLineObservation& o,
+bool linearize_line(const Context& c, const StereoLineObservation& o,
                                                   double info, const SE3& T, const Vector6d& L,
                                                   LineLinearization& lin) {
   const Eigen::Vector3d Xs = T * Eigen::Vector3d(L.head<3>());
