@@ -133,13 +133,9 @@ void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uin
   }
 }
 
-// Matching calls this millions of times per second. The build targets baseline x86-64, where
-// std::popcount is a libgcc call; a clone with the POPCNT instruction is picked at load time
-// when the CPU has it (GCC function multi-versioning), with identical results.
-#if defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("popcnt", "default")))
-#endif
-int hamming_distance(const uint8_t* a, const uint8_t* b) {
+namespace {
+template <bool kPortable>
+inline int hamming_impl(const uint8_t* a, const uint8_t* b) {
   int d = 0;
   for (int i = 0; i < kOrbDescriptorBytes; i += 8) {
     uint64_t x, y;
@@ -148,6 +144,24 @@ int hamming_distance(const uint8_t* a, const uint8_t* b) {
     d += std::popcount(x ^ y);
   }
   return d;
+}
+#if defined(__x86_64__)
+// Matching calls this millions of times per second. The build targets baseline x86-64, where
+// std::popcount is a libgcc call; this copy uses the POPCNT instruction. Dispatch by a flag set
+// at start-up: GCC's target_clones would need an ifunc resolver, which crashes under
+// ThreadSanitizer.
+__attribute__((target("popcnt"))) int hamming_popcnt(const uint8_t* a, const uint8_t* b) {
+  return hamming_impl<false>(a, b);
+}
+const bool kHasPopcnt = (__builtin_cpu_init(), __builtin_cpu_supports("popcnt"));
+#endif
+}  // namespace
+
+int hamming_distance(const uint8_t* a, const uint8_t* b) {
+#if defined(__x86_64__)
+  if (kHasPopcnt) return hamming_popcnt(a, b);
+#endif
+  return hamming_impl<true>(a, b);
 }
 
 }  // namespace plslam::features
