@@ -134,7 +134,6 @@ void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uin
 }
 
 namespace {
-template <bool kPortable>
 inline int hamming_impl(const uint8_t* a, const uint8_t* b) {
   int d = 0;
   for (int i = 0; i < kOrbDescriptorBytes; i += 8) {
@@ -151,7 +150,7 @@ inline int hamming_impl(const uint8_t* a, const uint8_t* b) {
 // at start-up: GCC's target_clones would need an ifunc resolver, which crashes under
 // ThreadSanitizer.
 __attribute__((target("popcnt"))) int hamming_popcnt(const uint8_t* a, const uint8_t* b) {
-  return hamming_impl<false>(a, b);
+  return hamming_impl(a, b);
 }
 const bool kHasPopcnt = (__builtin_cpu_init(), __builtin_cpu_supports("popcnt"));
 #endif
@@ -161,7 +160,7 @@ int hamming_distance(const uint8_t* a, const uint8_t* b) {
 #if defined(__x86_64__)
   if (kHasPopcnt) return hamming_popcnt(a, b);
 #endif
-  return hamming_impl<true>(a, b);
+  return hamming_impl(a, b);
 }
 
 }  // namespace plslam::features

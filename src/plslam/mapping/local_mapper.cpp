@@ -23,6 +23,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kChi2Mono = 5.991;
+constexpr double kChi2Epipolar = 3.84;  // 1 DoF, 95 %: distance of a keypoint to its epipolar line
 
 }  // namespace
 
@@ -215,7 +216,7 @@ void LocalMapper::triangulate(map::KeyFrame* kf) {
     std::vector<double> band;  // the epipolar test's gate below, plus rounding
     for (std::size_t l = 0; l < free2.size(); ++l) {
       index.emplace_back(free2_position[l], epipole);
-      band.push_back(std::sqrt(3.84 * d2.level_sigma2(static_cast<int>(l))) + 1e-6);
+      band.push_back(std::sqrt(kChi2Epipolar * d2.level_sigma2(static_cast<int>(l))) + 1e-6);
     }
     std::vector<int> candidates;
     std::vector<bool> used2(points2.size(), false);
@@ -240,7 +241,7 @@ void LocalMapper::triangulate(map::KeyFrame* kf) {
           if (used2[static_cast<std::size_t>(j)]) continue;
           const auto& kp2 = d2.keypoints[static_cast<std::size_t>(j)];
           const double dist_epi = std::abs(epiline.x() * kp2.pt.x + epiline.y() * kp2.pt.y + epiline.z()) / norm;
-          if (dist_epi * dist_epi > 3.84 * d2.level_sigma2(kp2.octave)) continue;
+          if (dist_epi * dist_epi > kChi2Epipolar * d2.level_sigma2(kp2.octave)) continue;
           const int h = features::hamming_distance(d1.descriptors.ptr<uint8_t>(static_cast<int>(i)),
                                                    d2.descriptors.ptr<uint8_t>(j));
           if (h < best || (h == best && j < best_j)) {  // ties: the lowest index, whatever the query order
