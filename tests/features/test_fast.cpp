@@ -161,6 +161,34 @@ TEST(Fast, IdenticalToOpenCvOnRealPyramidLevelsAndViews) {
   }
 }
 
+TEST(Fast, CornersHoldTheKeypoints) {
+  const cv::Mat img = test::points_texture(cv::Size(200, 120), 5);
+  for (FastImpl impl : {FastImpl::kAuto, FastImpl::kScalar, FastImpl::kOpenCv}) {
+    std::vector<cv::KeyPoint> ref;
+    cv::FAST(img, ref, 7, true);
+    FastCorners corners;
+    detect_fast(img, 7, corners, impl);
+    ASSERT_GT(corners.size(), 50u);
+    ASSERT_EQ(corners.score.size(), corners.size());
+    expect_same(corners.keypoints(), ref, to_string(impl));
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+      EXPECT_EQ(corners.x(i), static_cast<int>(ref[i].pt.x));
+      EXPECT_EQ(corners.y(i), static_cast<int>(ref[i].pt.y));
+      EXPECT_EQ(FastCorners::pack(corners.x(i), corners.y(i)), corners.position[i]);
+    }
+  }
+  // Round trip, and keypoints the compact layout cannot hold.
+  std::vector<cv::KeyPoint> kps{cv::KeyPoint(cv::Point2f(3.f, 65535.f), 7.f, -1.f, 255.f),
+                                cv::KeyPoint(cv::Point2f(0.f, 0.f), 7.f, -1.f, 0.f)};
+  const FastCorners c = FastCorners::from_keypoints(kps);
+  EXPECT_EQ(c.keypoint(0).pt, kps[0].pt);
+  EXPECT_EQ(c.keypoint(0).response, 255.f);
+  EXPECT_EQ(c.keypoint(1).response, 0.f);
+  for (const cv::KeyPoint& bad : {cv::KeyPoint(cv::Point2f(1.5f, 2.f), 7.f, -1.f, 9.f), cv::KeyPoint(cv::Point2f(1.f, 2.f), 7.f, -1.f, 9.5f),
+                                  cv::KeyPoint(cv::Point2f(-1.f, 2.f), 7.f, -1.f, 9.f), cv::KeyPoint(cv::Point2f(1.f, 2.f), 7.f, -1.f, 256.f)})
+    EXPECT_THROW(FastCorners::from_keypoints({bad}), std::invalid_argument);
+}
+
 TEST(Fast, ImplementationNamesAndAvailability) {
   for (FastImpl i : {FastImpl::kAuto, FastImpl::kAvx2, FastImpl::kSse2, FastImpl::kScalar, FastImpl::kOpenCv})
     EXPECT_EQ(parse_fast_impl(to_string(i)), i);

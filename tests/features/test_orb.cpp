@@ -158,12 +158,12 @@ TEST(OrbExtractor, IniMinModeAndShortLevelsStillFillTheBudget) {
     single.fast_threshold = o.fast_min_threshold;
     ImagePyramid pyr;
     OrbExtractor(single).build_pyramid(img, pyr);
-    const auto all = OrbExtractor(single).detect(pyr)[0].keypoints;
-    const auto mixed = OrbExtractor(o).detect(pyr)[0].keypoints;
+    const auto all = OrbExtractor(single).detect(pyr)[0].corners;
+    const auto mixed = OrbExtractor(o).detect(pyr)[0].corners;
     std::size_t strong = 0;
-    for (const auto& k : all) strong += k.response >= o.fast_ini_threshold;
+    for (const uint8_t s : all.score) strong += s >= o.fast_ini_threshold;
     std::size_t mixed_strong = 0;
-    for (const auto& k : mixed) mixed_strong += k.response >= o.fast_ini_threshold;
+    for (const uint8_t s : mixed.score) mixed_strong += s >= o.fast_ini_threshold;
     EXPECT_EQ(mixed_strong, strong);
     EXPECT_LT(mixed.size(), all.size());
     EXPECT_GE(mixed.size(), strong);
@@ -174,7 +174,7 @@ TEST(OrbExtractor, IniMinModeAndShortLevelsStillFillTheBudget) {
   ImagePyramid p;
   ex.build_pyramid(img, p);
   PyramidCandidates c = ex.detect(p);
-  c[7].keypoints.resize(3);
+  c[7].corners.resize(3);
   const auto targets = ex.level_targets(c);
   EXPECT_EQ(targets[7], 3);
   int sum = 0;

@@ -64,5 +64,14 @@ TEST(Quadtree, DeterministicAndSmallInputs) {
   EXPECT_EQ(quadtree_select(kps, 100, cv::Size(480, 640)).size(), 100u);
 }
 
+TEST(Quadtree, CornersGiveTheKeypointSelection) {
+  for (const cv::Size size : {cv::Size(752, 480), cv::Size(1226, 370), cv::Size(97, 61)}) {
+    const auto kps = clustered_keypoints(size.area() / 30, size, 4u + static_cast<uint32_t>(size.width));
+    const FastCorners corners = FastCorners::from_keypoints(kps);
+    for (const int target : {1, 37, 400, 1200})
+      EXPECT_EQ(quadtree_select(corners, target, size), quadtree_select(kps, target, size)) << size << " target " << target;
+  }
+}
+
 }  // namespace
 }  // namespace plslam::features

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <random>
 #include <set>
+#include <sstream>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -138,7 +140,7 @@ TEST(Ssc, FewCandidatesAreAllKept) {
   const SscResult r = ssc_select(kps, 50, size);
   EXPECT_EQ(r.kept.size(), kps.size());
   EXPECT_TRUE(ssc_select(kps, 0, size).kept.empty());
-  EXPECT_TRUE(ssc_select({}, 10, size).kept.empty());
+  EXPECT_TRUE(ssc_select(std::vector<cv::KeyPoint>{}, 10, size).kept.empty());
 }
 
 TEST(Ssc, UpperBoundIsTightForALattice) {
@@ -217,17 +219,106 @@ TEST(Ssc, RealPyramidCandidatesVectorAndPortableAgreeWithGuarantees) {
     const PyramidCandidates cand = ex.detect(p);
     const std::vector<int> targets = ex.level_targets(cand);
     for (std::size_t l = 0; l < cand.size(); ++l) {
-      const SscResult fast = ssc_select(cand[l].keypoints, targets[l], cand[l].region, 0.001, 11.0);
+      const std::vector<cv::KeyPoint> kps = cand[l].corners.keypoints();
+      const SscResult fast = ssc_select(kps, targets[l], cand[l].region, 0.001, 11.0);
       SscResult portable;
       {
         const detail::PortableSscScope scope;
-        portable = ssc_select(cand[l].keypoints, targets[l], cand[l].region, 0.001, 11.0);
+        portable = ssc_select(kps, targets[l], cand[l].region, 0.001, 11.0);
       }
       EXPECT_EQ(fast.kept, portable.kept) << seq << " level " << l;
       EXPECT_EQ(static_cast<int>(fast.kept.size()), targets[l]);
-      EXPECT_GT(min_max_norm_distance(cand[l].keypoints, fast.kept), fast.width);
+      EXPECT_GT(min_max_norm_distance(kps, fast.kept), fast.width);
     }
   }
+}
+
+// The corners path must keep exactly the corners the keypoint path keeps, in the same order,
+// with the same width and passes.
+void expect_corners_match_keypoints(const FastCorners& corners, int target, cv::Size size, double hint,
+                                    const std::string& what) {
+  const std::vector<cv::KeyPoint> kps = corners.keypoints();
+  const SscResult ref = ssc_select(kps, target, size, 0.001, hint);
+  for (const bool portable : {false, true}) {
+    SscCornersResult r;
+    if (portable) {
+      const detail::PortableSscScope scope;
+      r = ssc_select(corners, target, size, 0.001, hint);
+    } else {
+      r = ssc_select(corners, target, size, 0.001, hint);
+    }
+    const std::string tag = what + (portable ? " portable" : "");
+    ASSERT_EQ(r.kept.size(), ref.kept.size()) << tag;
+    ASSERT_EQ(r.kept.position.size(), r.kept.score.size()) << tag;
+    for (std::size_t i = 0; i < ref.kept.size(); ++i) {
+      const auto id = static_cast<std::size_t>(ref.kept[i]);
+      ASSERT_EQ(r.kept.position[i], corners.position[id]) << tag << " kept " << i;
+      ASSERT_EQ(r.kept.score[i], corners.score[id]) << tag << " kept " << i;
+    }
+    EXPECT_EQ(r.width, ref.width) << tag;
+    EXPECT_EQ(r.iterations, ref.iterations) << tag;
+  }
+}
+
+TEST(Ssc, CornersGiveTheKeypointSelection) {
+  for (const cv::Size size : {cv::Size(752, 480), cv::Size(97, 61), cv::Size(1226, 370)}) {
+    for (const bool clustered : {false, true}) {
+      auto kps = random_keypoints(size.area() / 25, size, 7u + static_cast<uint32_t>(size.width), clustered);
+      // The extreme scores too (the counting sort's first and last bins).
+      kps[3].response = 0.f;
+      kps[5].response = 255.f;
+      kps[8].response = 255.f;
+      const FastCorners corners = FastCorners::from_keypoints(kps);
+      for (const int target : {1, 7, 40, 333, static_cast<int>(kps.size()) - 1, static_cast<int>(kps.size()),
+                               static_cast<int>(kps.size()) + 5}) {
+        for (const double hint : {0.0, 3.0, 9.0}) {
+          std::ostringstream what;
+          what << size << (clustered ? " clustered" : "") << " target " << target << " hint " << hint;
+          expect_corners_match_keypoints(corners, target, size, hint, what.str());
+        }
+      }
+    }
+  }
+  // Many equal scores (long runs), and a single score.
+  const cv::Size size(300, 200);
+  auto kps = random_keypoints(6000, size, 77u);
+  for (std::size_t i = 0; i < kps.size(); ++i) kps[i].response = static_cast<float>(20 + (i % 3));
+  expect_corners_match_keypoints(FastCorners::from_keypoints(kps), 150, size, 0.0, "three scores");
+  for (auto& k : kps) k.response = 9.f;
+  expect_corners_match_keypoints(FastCorners::from_keypoints(kps), 150, size, 5.0, "one score");
+}
+
+TEST(Ssc, CornersOfRealPyramidsGiveTheKeypointSelection) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  for (const char* seq : {"kitti/sequences/06", "euroc/V1_01_easy_micro"}) {
+    const auto ds = io::open_dataset(data / seq);
+    const OrbExtractor ex(std::string(seq).find("kitti") != std::string::npos ? OrbOptions::kitti() : OrbOptions::euroc());
+    ImagePyramid p;
+    ex.build_pyramid(ds->load(ds->size() / 2).left, p);
+    const PyramidCandidates cand = ex.detect(p);
+    const std::vector<int> targets = ex.level_targets(cand);
+    for (std::size_t l = 0; l < cand.size(); ++l)
+      for (const double hint : {0.0, 11.0})
+        expect_corners_match_keypoints(cand[l].corners, targets[l], cand[l].region, hint,
+                                       std::string(seq) + " level " + std::to_string(l));
+  }
+}
+
+TEST(Ssc, CornersOutsideTheImageAreRejected) {
+  const cv::Size size(100, 80);
+  FastCorners c = FastCorners::from_keypoints(random_keypoints(500, size, 3u));
+  EXPECT_NO_THROW(ssc_select(c, 50, size));
+  FastCorners wide = c;
+  wide.position[17] = FastCorners::pack(100, 5);
+  EXPECT_THROW(ssc_select(wide, 50, size), std::invalid_argument);
+  FastCorners low = c;
+  low.position[499] = FastCorners::pack(5, 80);
+  EXPECT_THROW(ssc_select(low, 50, size), std::invalid_argument);
+  FastCorners ragged = c;
+  ragged.score.pop_back();
+  EXPECT_THROW(ssc_select(ragged, 50, size), std::invalid_argument);
+  EXPECT_TRUE(ssc_select(FastCorners{}, 10, size).kept.empty());
+  EXPECT_TRUE(ssc_select(c, 0, size).kept.empty());
 }
 
 TEST(Ssc, ReusedBuffersGiveIdenticalResultsAcrossManyCalls) {

@@ -182,13 +182,41 @@ FastImpl resolve_fast_impl(FastImpl impl) {
   return FastImpl::kScalar;
 }
 
-void detect_fast(const cv::Mat& image, int threshold, std::vector<cv::KeyPoint>& keypoints, FastImpl impl) {
-  keypoints.clear();
+cv::KeyPoint FastCorners::keypoint(std::size_t i) const {
+  return {cv::Point2f(static_cast<float>(x(i)), static_cast<float>(y(i))), 7.f, -1.f, static_cast<float>(score[i])};
+}
+
+std::vector<cv::KeyPoint> FastCorners::keypoints() const {
+  std::vector<cv::KeyPoint> out;
+  out.reserve(size());
+  for (std::size_t i = 0; i < size(); ++i) out.push_back(keypoint(i));
+  return out;
+}
+
+FastCorners FastCorners::from_keypoints(const std::vector<cv::KeyPoint>& keypoints) {
+  FastCorners out;
+  out.reserve(keypoints.size());
+  for (const auto& k : keypoints) {
+    const auto x = static_cast<int>(k.pt.x), y = static_cast<int>(k.pt.y), r = static_cast<int>(k.response);
+    const bool whole = k.pt.x >= 0.f && k.pt.y >= 0.f && k.pt.x < 65536.f && k.pt.y < 65536.f && k.response >= 0.f &&
+                       k.response < 256.f && static_cast<float>(x) == k.pt.x && static_cast<float>(y) == k.pt.y &&
+                       static_cast<float>(r) == k.response;
+    if (!whole) throw std::invalid_argument("FastCorners: keypoint not at a whole pixel or without an integer score");
+    out.push_back(pack(x, y), static_cast<uint8_t>(r));
+  }
+  return out;
+}
+
+void detect_fast(const cv::Mat& image, int threshold, FastCorners& corners, FastImpl impl) {
+  corners.clear();
   impl = resolve_fast_impl(impl);
   if (!fast_impl_available(impl)) throw std::invalid_argument(std::string("FAST implementation not available: ") + to_string(impl));
   if (image.type() != CV_8UC1) throw std::invalid_argument("detect_fast needs an 8-bit grey image");
+  if (image.cols > 65536 || image.rows > 65536) throw std::invalid_argument("detect_fast: image too large for FastCorners");
   if (impl == FastImpl::kOpenCv) {
+    std::vector<cv::KeyPoint> keypoints;
     cv::FAST(image, keypoints, threshold, true);
+    corners = FastCorners::from_keypoints(keypoints);
     return;
   }
   const int rows = image.rows, cols = image.cols;
@@ -215,12 +243,23 @@ void detect_fast(const cv::Mat& image, int threshold, std::vector<cv::KeyPoint>&
     // Row y - 1 is complete: its neighbours above (y - 2, zero for the first row) and below (y).
     const int found = k.nms_run(row(y - 2), row(y - 1), row(y), kRadius, cols - kRadius, xs.data());
     const uint8_t* s = row(y - 1);
+    const uint32_t row_bits = FastCorners::pack(0, y - 1);
     for (int i = 0; i < found; ++i) {
       const int x = xs[static_cast<std::size_t>(i)];
-      keypoints.emplace_back(cv::Point2f(static_cast<float>(x), static_cast<float>(y - 1)), 7.f, -1.f,
-                             static_cast<float>(s[x]));
+      corners.push_back(row_bits | static_cast<uint32_t>(x), s[x]);
     }
   }
+}
+
+void detect_fast(const cv::Mat& image, int threshold, std::vector<cv::KeyPoint>& keypoints, FastImpl impl) {
+  keypoints.clear();
+  if (resolve_fast_impl(impl) == FastImpl::kOpenCv && fast_impl_available(impl) && image.type() == CV_8UC1) {
+    cv::FAST(image, keypoints, threshold, true);
+    return;
+  }
+  FastCorners corners;
+  detect_fast(image, threshold, corners, impl);
+  keypoints = corners.keypoints();
 }
 
 int fast_corner_score(const cv::Mat& image, int x, int y, int threshold) {

@@ -6,6 +6,8 @@
 // 32 pixels at once: the score is max over arcs of the min absolute difference along the arc,
 // and a pixel is a corner exactly when that value exceeds t, so detection needs no separate
 // segment test and no per-corner scalar scoring as in OpenCV.
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -21,6 +23,45 @@ enum class FastImpl {
   kOpenCv,  // cv::FAST, kept selectable for comparisons
 };
 
+// FAST corners in a compact layout (structure of arrays): 5 bytes per corner instead of a 28-byte
+// cv::KeyPoint, so that the spatial distributions, which read every candidate, stream little
+// memory. Coordinates are whole pixels below 65536.
+struct FastCorners {
+  std::vector<uint32_t> position;  // y << 16 | x
+  std::vector<uint8_t> score;      // the FAST score (cv::KeyPoint::response)
+
+  static uint32_t pack(int x, int y) { return static_cast<uint32_t>(y) << 16 | static_cast<uint32_t>(x); }
+  static int x_of(uint32_t p) { return static_cast<int>(p & 0xFFFFu); }
+  static int y_of(uint32_t p) { return static_cast<int>(p >> 16); }
+
+  std::size_t size() const { return position.size(); }
+  bool empty() const { return position.empty(); }
+  void clear() {
+    position.clear();
+    score.clear();
+  }
+  void reserve(std::size_t n) {
+    position.reserve(n);
+    score.reserve(n);
+  }
+  void resize(std::size_t n) {
+    position.resize(n);
+    score.resize(n);
+  }
+  void push_back(uint32_t packed, uint8_t s) {
+    position.push_back(packed);
+    score.push_back(s);
+  }
+  int x(std::size_t i) const { return x_of(position[i]); }
+  int y(std::size_t i) const { return y_of(position[i]); }
+  // As detect_fast's cv::KeyPoint: (x, y), size 7, angle -1, response = score.
+  cv::KeyPoint keypoint(std::size_t i) const;
+  std::vector<cv::KeyPoint> keypoints() const;
+  // From keypoints at whole-pixel positions in [0, 65536)^2 with integer responses in [0, 256)
+  // (cv::FAST's); throws std::invalid_argument otherwise.
+  static FastCorners from_keypoints(const std::vector<cv::KeyPoint>& keypoints);
+};
+
 const char* to_string(FastImpl impl);
 FastImpl parse_fast_impl(const std::string& name);  // auto|avx2|sse2|scalar|opencv, else InputError
 bool fast_impl_available(FastImpl impl);
@@ -32,6 +73,9 @@ FastImpl resolve_fast_impl(FastImpl impl);
 // which the pixel is still a corner. Throws std::invalid_argument when `impl` is not available.
 void detect_fast(const cv::Mat& image, int threshold, std::vector<cv::KeyPoint>& keypoints,
                  FastImpl impl = FastImpl::kAuto);
+// The same corners, in the same order, in the compact layout (the image must be narrower and
+// lower than 65536 pixels).
+void detect_fast(const cv::Mat& image, int threshold, FastCorners& corners, FastImpl impl = FastImpl::kAuto);
 
 // Score of one pixel (at least 3 px inside the image) by the definition, or -1 when it is not a
 // corner at `threshold`; for tests.

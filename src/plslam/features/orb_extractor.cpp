@@ -30,24 +30,24 @@ constexpr int kIniMinCell = 30;
 // (non-maximum suppression agrees too: a stronger neighbour would itself pass the initial
 // threshold). Cells with no strong corner keep their weak ones. Running FAST per cell as
 // ORB-SLAM2 does costs ~40 % more here because of the many small calls.
-void detect_ini_min(const cv::Mat& region, const OrbOptions& o, std::vector<cv::KeyPoint>& out) {
-  std::vector<cv::KeyPoint> all;
+void detect_ini_min(const cv::Mat& region, const OrbOptions& o, FastCorners& out) {
+  FastCorners all;
   detect_fast(region, o.fast_min_threshold, all, o.fast_impl);
   const int inner_w = region.cols - 2 * kFastRadius, inner_h = region.rows - 2 * kFastRadius;
   const int n_cols = std::max(1, inner_w / kIniMinCell), n_rows = std::max(1, inner_h / kIniMinCell);
   const int cell_w = (inner_w + n_cols - 1) / n_cols, cell_h = (inner_h + n_rows - 1) / n_rows;
-  auto cell_of = [&](const cv::KeyPoint& k) {
-    const int cx = std::clamp((static_cast<int>(k.pt.x) - kFastRadius) / cell_w, 0, n_cols - 1);
-    const int cy = std::clamp((static_cast<int>(k.pt.y) - kFastRadius) / cell_h, 0, n_rows - 1);
+  auto cell_of = [&](std::size_t i) {
+    const int cx = std::clamp((all.x(i) - kFastRadius) / cell_w, 0, n_cols - 1);
+    const int cy = std::clamp((all.y(i) - kFastRadius) / cell_h, 0, n_rows - 1);
     return static_cast<std::size_t>(cy * n_cols + cx);
   };
-  const auto ini = static_cast<float>(o.fast_ini_threshold);
+  const int ini = o.fast_ini_threshold;
   std::vector<char> has_strong(static_cast<std::size_t>(n_cols * n_rows), 0);
-  for (const auto& k : all)
-    if (k.response >= ini) has_strong[cell_of(k)] = 1;
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if (all.score[i] >= ini) has_strong[cell_of(i)] = 1;
   out.clear();
-  for (const auto& k : all)
-    if (k.response >= ini || !has_strong[cell_of(k)]) out.push_back(k);
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if (all.score[i] >= ini || !has_strong[cell_of(i)]) out.push_back(all.position[i], all.score[i]);
 }
 
 }  // namespace
@@ -99,11 +99,10 @@ PyramidCandidates OrbExtractor::detect(const ImagePyramid& pyramid) const {
     }
     const cv::Mat region = img(cv::Rect(lc.offset, lc.region));
     if (options_.fast_mode == FastMode::kSingle) {
-      detect_fast(region, options_.fast_threshold, lc.keypoints, options_.fast_impl);
+      detect_fast(region, options_.fast_threshold, lc.corners, options_.fast_impl);
     } else {
-      detect_ini_min(region, options_, lc.keypoints);
+      detect_ini_min(region, options_, lc.corners);
     }
-    for (auto& k : lc.keypoints) k.octave = l;
   }
   return out;
 }
@@ -132,7 +131,7 @@ std::vector<int> OrbExtractor::level_targets(const PyramidCandidates& candidates
     }
     if (last_open < n) target[last_open] = std::max(0, target[last_open] + remaining - assigned);
     for (std::size_t l = 0; l < n; ++l) {
-      const int have = static_cast<int>(candidates[l].keypoints.size());
+      const int have = static_cast<int>(candidates[l].corners.size());
       if (!capped[l] && target[l] > have) {
         target[l] = have;
         capped[l] = 1;
@@ -162,26 +161,30 @@ PyramidCandidates OrbExtractor::distribute(const PyramidCandidates& candidates, 
       width_hint = 0.5 * std::sqrt(static_cast<double>(lc.region.area()) / static_cast<double>(targets[l]));
     out[l].offset = lc.offset;
     out[l].region = lc.region;
-    std::vector<int> kept;
     if (method == Distribution::kSsc) {
-      SscResult res = ssc_select(lc.keypoints, targets[l], lc.region, options_.ssc_tolerance, width_hint);
+      SscCornersResult res = ssc_select(lc.corners, targets[l], lc.region, options_.ssc_tolerance, width_hint);
       if (res.width > 0) {
         width_hint = last_width > 0 ? std::floor(0.5 * (res.width + last_width) + 0.5) : res.width;
         last_width = res.width;
       }
-      kept = std::move(res.kept);
+      out[l].corners = std::move(res.kept);
     } else {
-      kept = quadtree_select(lc.keypoints, targets[l], lc.region);
+      const std::vector<int> kept = quadtree_select(lc.corners, targets[l], lc.region);
+      FastCorners& o = out[l].corners;
+      o.resize(kept.size());
+      for (std::size_t i = 0; i < kept.size(); ++i) {
+        const auto id = static_cast<std::size_t>(kept[i]);
+        o.position[i] = lc.corners.position[id];
+        o.score[i] = lc.corners.score[id];
+      }
     }
-    out[l].keypoints.reserve(kept.size());
-    for (int i : kept) out[l].keypoints.push_back(lc.keypoints[static_cast<std::size_t>(i)]);
   }
   return out;
 }
 
 void OrbExtractor::describe(const ImagePyramid& pyramid, const PyramidCandidates& kept, PointFeatures& out) const {
   std::size_t total = 0;
-  for (const auto& lc : kept) total += lc.keypoints.size();
+  for (const auto& lc : kept) total += lc.corners.size();
   out.keypoints.clear();
   out.keypoints.reserve(total);
   out.descriptors.create(static_cast<int>(total), kOrbDescriptorBytes, CV_8U);
@@ -193,20 +196,20 @@ void OrbExtractor::describe(const ImagePyramid& pyramid, const PyramidCandidates
   static_assert(kBlurRadius == 3, "gaussian_blur_7x7 reads 3 pixels around its rectangle");
   for (int l = 0; l < pyramid.levels() && l < static_cast<int>(kept.size()); ++l) {
     const auto& lc = kept[static_cast<std::size_t>(l)];
-    if (lc.keypoints.empty()) continue;
+    if (lc.corners.empty()) continue;
     const cv::Mat& level = pyramid.level(l);
     const int b = pyramid.border();
     const cv::Rect blur_rect(b - expand, b - expand, level.cols + 2 * expand, level.rows + 2 * expand);
     gaussian_blur_7x7(pyramid.padded(l), blur_rect, blurred);
     const float size = static_cast<float>(31.0 * pyramid.scale(l));
-    for (const auto& k : lc.keypoints) {
-      const int x = static_cast<int>(k.pt.x) + lc.offset.x;
-      const int y = static_cast<int>(k.pt.y) + lc.offset.y;
+    for (std::size_t i = 0; i < lc.corners.size(); ++i) {
+      const int x = lc.corners.x(i) + lc.offset.x;
+      const int y = lc.corners.y(i) + lc.offset.y;
       const float angle = intensity_centroid_angle(level, x, y);
       brief_descriptor(blurred, x + expand, y + expand, angle, out.descriptors.ptr<uint8_t>(row++));
       out.keypoints.emplace_back(cv::Point2f(pyramid.from_level_x(static_cast<float>(x), l),
                                              pyramid.from_level_y(static_cast<float>(y), l)),
-                                 size, angle, k.response, l);
+                                 size, angle, static_cast<float>(lc.corners.score[i]), l);
     }
   }
 }
@@ -220,7 +223,7 @@ PointFeatures OrbExtractor::extract(const cv::Mat& image, ExtractionTimings* tim
   t0 = Clock::now();
   const PyramidCandidates candidates = detect(out.pyramid);
   t.fast_ms = ms_since(t0);
-  for (const auto& lc : candidates) t.fast_candidates += static_cast<int>(lc.keypoints.size());
+  for (const auto& lc : candidates) t.fast_candidates += static_cast<int>(lc.corners.size());
   t0 = Clock::now();
   const PyramidCandidates kept = distribute(candidates, options_.distribution);
   t.distribution_ms = ms_since(t0);

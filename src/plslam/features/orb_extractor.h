@@ -63,11 +63,11 @@ struct PointFeatures {
 };
 
 // FAST corners of one level, in coordinates relative to `offset` within the level image and
-// inside [0, region.width) x [0, region.height).
+// inside [0, region.width) x [0, region.height), in the compact layout both distributions read.
 struct LevelCandidates {
   cv::Point offset;
   cv::Size region;
-  std::vector<cv::KeyPoint> keypoints;
+  FastCorners corners;
 };
 using PyramidCandidates = std::vector<LevelCandidates>;
 

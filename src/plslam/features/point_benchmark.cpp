@@ -33,10 +33,12 @@ std::vector<cv::KeyPoint> to_level0(const PyramidCandidates& kept, const ImagePy
   std::vector<cv::KeyPoint> out;
   for (std::size_t l = 0; l < kept.size(); ++l) {
     const int level = static_cast<int>(l);
-    for (const auto& k : kept[l].keypoints) {
-      cv::KeyPoint p = k;
-      p.pt = {pyramid.from_level_x(k.pt.x + static_cast<float>(kept[l].offset.x), level),
-              pyramid.from_level_y(k.pt.y + static_cast<float>(kept[l].offset.y), level)};
+    const FastCorners& c = kept[l].corners;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      cv::KeyPoint p = c.keypoint(i);
+      p.pt = {pyramid.from_level_x(p.pt.x + static_cast<float>(kept[l].offset.x), level),
+              pyramid.from_level_y(p.pt.y + static_cast<float>(kept[l].offset.y), level)};
+      p.octave = level;
       out.push_back(p);
     }
   }
@@ -45,7 +47,7 @@ std::vector<cv::KeyPoint> to_level0(const PyramidCandidates& kept, const ImagePy
 
 int count(const PyramidCandidates& c) {
   int n = 0;
-  for (const auto& lc : c) n += static_cast<int>(lc.keypoints.size());
+  for (const auto& lc : c) n += static_cast<int>(lc.corners.size());
   return n;
 }
 

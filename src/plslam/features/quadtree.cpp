@@ -15,9 +15,27 @@ struct Node {
   int size() const { return end - begin; }
 };
 
+// Point access to the two input layouts.
+struct KeyPointInput {
+  const std::vector<cv::KeyPoint>& kps;
+  std::size_t size() const { return kps.size(); }
+  cv::Point2f point(int i) const { return kps[static_cast<std::size_t>(i)].pt; }
+  float response(int i) const { return kps[static_cast<std::size_t>(i)].response; }
+};
+struct CornerInput {
+  const FastCorners& corners;
+  std::size_t size() const { return corners.size(); }
+  cv::Point2f point(int i) const {
+    const uint32_t p = corners.position[static_cast<std::size_t>(i)];
+    return {static_cast<float>(FastCorners::x_of(p)), static_cast<float>(FastCorners::y_of(p))};
+  }
+  int response(int i) const { return corners.score[static_cast<std::size_t>(i)]; }
+};
+
+template <class Input>
 class QuadTree {
  public:
-  QuadTree(const std::vector<cv::KeyPoint>& kps) : kps_(kps) {}
+  explicit QuadTree(const Input& in) : in_(in) {}
 
   // Splits `n` into up to four non-empty children appended to `out`. Returns how many of them
   // hold more than one point (the ones that may split again).
@@ -26,14 +44,14 @@ class QuadTree {
     std::array<int, 4> count{};
     scratch_.resize(static_cast<std::size_t>(n.size()));
     for (int i = n.begin; i < n.end; ++i) {
-      const auto& p = kps_[static_cast<std::size_t>(idx_[static_cast<std::size_t>(i)])].pt;
+      const cv::Point2f p = in_.point(idx_[static_cast<std::size_t>(i)]);
       ++count[static_cast<std::size_t>(quadrant(p, xm, ym))];
     }
     std::array<int, 4> pos{0, count[0], count[0] + count[1], count[0] + count[1] + count[2]};
     const std::array<int, 4> first = pos;
     for (int i = n.begin; i < n.end; ++i) {
       const int id = idx_[static_cast<std::size_t>(i)];
-      const int q = quadrant(kps_[static_cast<std::size_t>(id)].pt, xm, ym);
+      const int q = quadrant(in_.point(id), xm, ym);
       scratch_[static_cast<std::size_t>(pos[static_cast<std::size_t>(q)]++)] = id;
     }
     std::copy(scratch_.begin(), scratch_.end(), idx_.begin() + n.begin);
@@ -55,22 +73,21 @@ class QuadTree {
   static int quadrant(const cv::Point2f& p, float xm, float ym) {
     return (p.x < xm ? 0 : 1) + (p.y < ym ? 0 : 2);
   }
-  const std::vector<cv::KeyPoint>& kps_;
+  const Input& in_;
   std::vector<int> scratch_;
 };
 
-}  // namespace
-
-std::vector<int> quadtree_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size) {
-  const int k = static_cast<int>(keypoints.size());
+template <class Input>
+std::vector<int> select(const Input& in, int target, cv::Size size) {
+  const int k = static_cast<int>(in.size());
   if (target <= 0 || k == 0) return {};
-  QuadTree tree(keypoints);
+  QuadTree<Input> tree(in);
   // Initial nodes: as many square-ish columns as the aspect ratio asks for (at least one).
   const int n_ini = std::max(1, static_cast<int>(std::lround(static_cast<double>(size.width) / size.height)));
   const float hx = static_cast<float>(size.width) / static_cast<float>(n_ini);
   std::vector<std::vector<int>> columns(static_cast<std::size_t>(n_ini));
   for (int i = 0; i < k; ++i) {
-    const int c = std::clamp(static_cast<int>(keypoints[static_cast<std::size_t>(i)].pt.x / hx), 0, n_ini - 1);
+    const int c = std::clamp(static_cast<int>(in.point(i).x / hx), 0, n_ini - 1);
     columns[static_cast<std::size_t>(c)].push_back(i);
   }
   std::vector<Node> nodes, next;
@@ -138,15 +155,23 @@ std::vector<int> quadtree_select(const std::vector<cv::KeyPoint>& keypoints, int
     int best = tree.idx_[static_cast<std::size_t>(n.begin)];
     for (int i = n.begin + 1; i < n.end; ++i) {
       const int id = tree.idx_[static_cast<std::size_t>(i)];
-      if (keypoints[static_cast<std::size_t>(id)].response > keypoints[static_cast<std::size_t>(best)].response) best = id;
+      if (in.response(id) > in.response(best)) best = id;
     }
     kept.push_back(best);
   }
-  std::stable_sort(kept.begin(), kept.end(), [&](int a, int b) {
-    return keypoints[static_cast<std::size_t>(a)].response > keypoints[static_cast<std::size_t>(b)].response;
-  });
+  std::stable_sort(kept.begin(), kept.end(), [&](int a, int b) { return in.response(a) > in.response(b); });
   if (static_cast<int>(kept.size()) > target) kept.resize(static_cast<std::size_t>(target));
   return kept;
+}
+
+}  // namespace
+
+std::vector<int> quadtree_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size) {
+  return select(KeyPointInput{keypoints}, target, size);
+}
+
+std::vector<int> quadtree_select(const FastCorners& corners, int target, cv::Size size) {
+  return select(CornerInput{corners}, target, size);
 }
 
 }  // namespace plslam::features

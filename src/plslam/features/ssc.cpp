@@ -113,6 +113,8 @@ struct Workspace {
   std::array<Scratch<int>, 2> kept;  // the current pass and the best one so far
   Scratch<uint32_t> pos, position;
   Scratch<uint8_t> bin;
+  Scratch<uint64_t> run_marks;  // gather_kept's run starts
+  Scratch<int> run_rank;
   // The cover grid of a pass: a cell is covered when it holds the pass's stamp, so that a new
   // pass needs no clearing (only when the stamps wrap around or the grid grows).
   Scratch<uint8_t> grid;
@@ -265,6 +267,185 @@ SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv:
     position[dst] = pos[i];
   });
   return s;
+}
+
+// The extent of a corner set: largest x and y, smallest and largest score.
+struct CornerExtent {
+  uint32_t max_x = 0, max_y = 0;
+  int min_score = kScoreBins - 1, max_score = 0;
+};
+
+CornerExtent corner_extent_portable(const FastCorners& corners) {
+  CornerExtent e;
+  uint32_t mx = 0, my = 0;
+  for (const uint32_t p : corners.position) {
+    mx = std::max(mx, p & 0xFFFFu);
+    my = std::max(my, p >> 16);
+  }
+  uint8_t lo = kScoreBins - 1, hi = 0;
+  for (const uint8_t s : corners.score) {
+    lo = std::min(lo, s);
+    hi = std::max(hi, s);
+  }
+  e.max_x = mx;
+  e.max_y = my;
+  e.min_score = lo;
+  e.max_score = hi;
+  return e;
+}
+
+#ifdef PLSLAM_SSC_AVX2
+#pragma GCC push_options
+#pragma GCC target("avx2")
+// As corner_extent_portable, 16 coordinates or 32 scores per instruction.
+CornerExtent corner_extent_avx2(const FastCorners& corners) {
+  const std::size_t n = corners.size();
+  const uint32_t* p = corners.position.data();
+  const uint8_t* s = corners.score.data();
+  __m256i max_xy = _mm256_setzero_si256();  // 16-bit lanes: x, y, x, y, ...
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) max_xy = _mm256_max_epu16(max_xy, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + i)));
+  alignas(32) std::array<uint16_t, 16> xy{};
+  _mm256_store_si256(reinterpret_cast<__m256i*>(xy.data()), max_xy);
+  CornerExtent e;
+  for (std::size_t j = 0; j < 16; j += 2) {
+    e.max_x = std::max<uint32_t>(e.max_x, xy[j]);
+    e.max_y = std::max<uint32_t>(e.max_y, xy[j + 1]);
+  }
+  for (; i < n; ++i) {
+    e.max_x = std::max(e.max_x, p[i] & 0xFFFFu);
+    e.max_y = std::max(e.max_y, p[i] >> 16);
+  }
+  __m256i lo = _mm256_set1_epi8(-1), hi = _mm256_setzero_si256();
+  std::size_t j = 0;
+  for (; j + 32 <= n; j += 32) {
+    const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s + j));
+    lo = _mm256_min_epu8(lo, v);
+    hi = _mm256_max_epu8(hi, v);
+  }
+  alignas(32) std::array<uint8_t, 32> l{}, h{};
+  _mm256_store_si256(reinterpret_cast<__m256i*>(l.data()), lo);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(h.data()), hi);
+  int min_s = *std::min_element(l.begin(), l.end()), max_s = *std::max_element(h.begin(), h.end());
+  for (; j < n; ++j) {
+    min_s = std::min<int>(min_s, s[j]);
+    max_s = std::max<int>(max_s, s[j]);
+  }
+  e.min_score = min_s;
+  e.max_score = max_s;
+  return e;
+}
+#pragma GCC pop_options
+#endif
+
+bool use_avx2();
+
+CornerExtent corner_extent(const FastCorners& corners) {
+#ifdef PLSLAM_SSC_AVX2
+  if (use_avx2()) return corner_extent_avx2(corners);
+#endif
+  return corner_extent_portable(corners);
+}
+
+// Corners already hold packed positions and integer scores: the counting sort reads them
+// directly (5 bytes per candidate) and scatters only positions; no index is needed, since the
+// kept corners are returned as positions and scores (gather_kept). Counters are cleared and
+// summed over the scores in use only (`extent`).
+// bin_begin[b]: first sorted slot of score 255 - b; bin_begin[256] = k.
+SortedCandidates sort_corners(const FastCorners& corners, const CornerExtent& extent, Workspace& ws,
+                              std::array<int, kScoreBins + 1>& bin_begin) {
+  const int k = static_cast<int>(corners.size());
+  uint32_t* position = ws.position.get(static_cast<std::size_t>(k));
+  const SortedCandidates s{nullptr, position, k};
+  const uint8_t* score = corners.score.data();
+  const uint32_t* pos = corners.position.data();
+  // Four consecutive parts with their own counters, as in sort_candidates.
+  constexpr int kParts = 4;
+  std::array<std::array<int, kScoreBins>, kParts> next;
+  const int lo = extent.min_score, hi = extent.max_score;
+  for (auto& counters : next) std::fill(counters.begin() + lo, counters.begin() + hi + 1, 0);
+  std::array<int, kParts + 1> part_begin{};
+  for (int q = 0; q <= kParts; ++q) part_begin[static_cast<std::size_t>(q)] = static_cast<int>(static_cast<int64_t>(k) * q / kParts);
+  const int common = k / kParts;
+  auto for_each_part = [&](auto&& f) {
+    for (int j = 0; j < common; ++j)
+      for (int q = 0; q < kParts; ++q) f(q, part_begin[static_cast<std::size_t>(q)] + j);
+    for (int q = 0; q < kParts; ++q)
+      for (int i = part_begin[static_cast<std::size_t>(q)] + common; i < part_begin[static_cast<std::size_t>(q) + 1]; ++i) f(q, i);
+  };
+  for_each_part([&](int q, int i) { ++next[static_cast<std::size_t>(q)][score[i]]; });
+  // Counts -> first output slot of each (score, part), strongest score first.
+  std::fill(bin_begin.begin(), bin_begin.begin() + (kScoreBins - hi), 0);
+  int offset = 0;
+  for (int sc = hi; sc >= lo; --sc) {
+    bin_begin[static_cast<std::size_t>(kScoreBins - 1 - sc)] = offset;
+    for (std::size_t q = 0; q < kParts; ++q) {
+      const int c = next[q][static_cast<std::size_t>(sc)];
+      next[q][static_cast<std::size_t>(sc)] = offset;
+      offset += c;
+    }
+  }
+  std::fill(bin_begin.begin() + (kScoreBins - lo), bin_begin.end(), offset);
+  for_each_part([&](int q, int i) { position[next[static_cast<std::size_t>(q)][score[i]]++] = pos[i]; });
+  return s;
+}
+
+// Positions and scores of the sorted slots `slots[0, n)`. The score of a slot is that of the
+// run of equal scores holding it, found without branches (walking the runs alongside the slots
+// mispredicts at most run changes, which are frequent among kept points): a bitmap marks the first
+// slot of every non-empty run, and the run's rank is the number of marks up to the slot (a
+// prefix count per 64-bit word plus a popcount).
+inline void gather_kept_impl(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin,
+                             const int* slots, int n, FastCorners& out, Workspace& ws) {
+  out.resize(static_cast<std::size_t>(n));
+  uint32_t* out_position = out.position.data();
+  uint8_t* out_score = out.score.data();
+  const uint32_t* position = sorted.position;
+  const auto words = static_cast<std::size_t>(sorted.size / 64 + 1);
+  uint64_t* marks = ws.run_marks.get(words);
+  int* below = ws.run_rank.get(words);
+  std::fill_n(marks, words, uint64_t{0});
+  std::array<uint8_t, kScoreBins + 1> run_score;
+  int runs = 0;
+  for (std::size_t b = 0; b < kScoreBins; ++b) {
+    const int first = bin_begin[b];
+    if (bin_begin[b + 1] == first) continue;
+    marks[static_cast<std::size_t>(first) >> 6] |= uint64_t{1} << (first & 63);
+    run_score[static_cast<std::size_t>(++runs)] = static_cast<uint8_t>(kScoreBins - 1 - static_cast<int>(b));
+  }
+  auto popcount = [](uint64_t v) { return __builtin_popcountll(v); };
+  int total = 0;
+  for (std::size_t w = 0; w < words; ++w) {
+    below[w] = total;
+    total += popcount(marks[w]);
+  }
+  for (int i = 0; i < n; ++i) {
+    const auto slot = static_cast<uint32_t>(slots[i]);
+    const std::size_t w = slot >> 6;
+    const int rank = below[w] + popcount(marks[w] & (~uint64_t{0} >> (63 - (slot & 63))));
+    out_position[i] = position[slot];
+    out_score[i] = run_score[static_cast<std::size_t>(rank)];
+  }
+}
+
+#ifdef PLSLAM_SSC_AVX2
+#pragma GCC push_options
+#pragma GCC target("popcnt")
+// The same, inlined here so that the popcounts become POPCNT instructions.
+[[gnu::flatten]] void gather_kept_popcnt(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin,
+                                         const int* slots, int n, FastCorners& out, Workspace& ws) {
+  gather_kept_impl(sorted, bin_begin, slots, n, out, ws);
+}
+#pragma GCC pop_options
+#endif
+
+void gather_kept(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin, const int* slots, int n,
+                 FastCorners& out, Workspace& ws) {
+#ifdef PLSLAM_SSC_AVX2
+  static const bool has_popcnt = __builtin_cpu_supports("popcnt");
+  if (has_popcnt && !detail::ssc_portable_only()) return gather_kept_popcnt(sorted, bin_begin, slots, n, out, ws);
+#endif
+  gather_kept_impl(sorted, bin_begin, slots, n, out, ws);
 }
 
 // The cell of pixel coordinate x at width w is floor(2x / w) (cells of side w/2), computed as
@@ -441,18 +622,23 @@ namespace detail {
 int ssc_cell(uint32_t x, int w) { return Grid(cv::Size(1, 1), w).cell_of_coordinate(x); }
 }  // namespace detail
 
-SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
-                     double tolerance_fraction, double width_hint) {
-  SscResult result;
-  const int k = static_cast<int>(keypoints.size());
-  if (target <= 0 || k == 0 || size.width < 1 || size.height < 1) return result;
-  if (size.width > 65535 || size.height > 65535) throw std::invalid_argument("ssc_select: image too large");
-  if (k <= target) {
-    result.kept = order_by_response(keypoints);
-    return result;
-  }
-  Workspace& ws = workspace();
-  const SortedCandidates sorted = sort_candidates(keypoints, size, ws);
+namespace {
+
+// The outcome of the width search over sorted candidates: the kept ones as sorted positions
+// (slots), strongest first.
+struct Selection {
+  const int* slots = nullptr;
+  int count = 0;
+  double width = 0;
+  int iterations = 0;
+};
+
+// The search for the widest covering that keeps `target` (+- tolerance) of the k > target
+// sorted candidates.
+Selection search_width(const SortedCandidates& sorted, int target, cv::Size size, double tolerance_fraction,
+                       double width_hint, Workspace& ws) {
+  Selection result;
+  const int k = sorted.size;
   const int tolerance = static_cast<int>(std::floor(tolerance_fraction * target));
   const SscBounds bounds = ssc_width_bounds(k, target, size);
 
@@ -515,9 +701,57 @@ SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv:
     ++result.iterations;
   }
   if (best_count > target + tolerance) best_count = target;
+  result.slots = best;
+  result.count = best_count;
   result.width = best_width;
-  result.kept.resize(static_cast<std::size_t>(best_count));
-  for (int i = 0; i < best_count; ++i) result.kept[static_cast<std::size_t>(i)] = sorted.index[best[i]];
+  return result;
+}
+
+}  // namespace
+
+SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
+                     double tolerance_fraction, double width_hint) {
+  SscResult result;
+  const int k = static_cast<int>(keypoints.size());
+  if (target <= 0 || k == 0 || size.width < 1 || size.height < 1) return result;
+  if (size.width > 65535 || size.height > 65535) throw std::invalid_argument("ssc_select: image too large");
+  if (k <= target) {
+    result.kept = order_by_response(keypoints);
+    return result;
+  }
+  Workspace& ws = workspace();
+  const SortedCandidates sorted = sort_candidates(keypoints, size, ws);
+  const Selection sel = search_width(sorted, target, size, tolerance_fraction, width_hint, ws);
+  result.width = sel.width;
+  result.iterations = sel.iterations;
+  result.kept.resize(static_cast<std::size_t>(sel.count));
+  for (int i = 0; i < sel.count; ++i) result.kept[static_cast<std::size_t>(i)] = sorted.index[sel.slots[i]];
+  return result;
+}
+
+SscCornersResult ssc_select(const FastCorners& corners, int target, cv::Size size, double tolerance_fraction,
+                            double width_hint) {
+  SscCornersResult result;
+  const int k = static_cast<int>(corners.size());
+  if (corners.score.size() != corners.position.size()) throw std::invalid_argument("ssc_select: corner arrays differ in length");
+  if (target <= 0 || k == 0 || size.width < 1 || size.height < 1) return result;
+  if (size.width > 65535 || size.height > 65535) throw std::invalid_argument("ssc_select: image too large");
+  const CornerExtent extent = corner_extent(corners);
+  if (extent.max_x >= static_cast<uint32_t>(size.width) || extent.max_y >= static_cast<uint32_t>(size.height))
+    throw std::invalid_argument("ssc_select: corner outside the image");
+  Workspace& ws = workspace();
+  std::array<int, kScoreBins + 1> bin_begin;
+  const SortedCandidates sorted = sort_corners(corners, extent, ws, bin_begin);
+  if (k <= target) {
+    std::vector<int> all(static_cast<std::size_t>(k));
+    std::iota(all.begin(), all.end(), 0);
+    gather_kept(sorted, bin_begin, all.data(), k, result.kept, ws);
+    return result;
+  }
+  const Selection sel = search_width(sorted, target, size, tolerance_fraction, width_hint, ws);
+  result.width = sel.width;
+  result.iterations = sel.iterations;
+  gather_kept(sorted, bin_begin, sel.slots, sel.count, result.kept, ws);
   return result;
 }
 

@@ -5,9 +5,13 @@
 // found by a search between closed-form bounds (derived in ssc.cpp), galloping from a hint.
 // Speed (ssc.cpp): one counting sort of the integer FAST scores, then passes that test 8
 // candidates at once with AVX2 when the CPU has it (a portable scan gives identical results).
+// The extractor passes FastCorners (packed positions and byte scores), which the sort reads
+// directly; cv::KeyPoint input is converted first.
 #include <vector>
 
 #include <opencv2/core.hpp>
+
+#include "plslam/features/fast_detector.h"
 
 namespace plslam::features {
 
@@ -39,6 +43,19 @@ struct SscResult {
 // which feasible width is found first.
 SscResult ssc_select(const std::vector<cv::KeyPoint>& keypoints, int target, cv::Size size,
                      double tolerance_fraction = 0.001, double width_hint = 0);
+
+struct SscCornersResult {
+  FastCorners kept;  // strongest first
+  double width = 0;
+  int iterations = 0;
+};
+
+// The same selection on the compact layout (the extractor's path): for corners c,
+// ssc_select(c, ...).kept lists the corners at ssc_select(c.keypoints(), ...).kept, in that order,
+// with the same width and passes. Reads 5 bytes per candidate and scatters positions only.
+// Corners must lie inside `size` (std::invalid_argument otherwise).
+SscCornersResult ssc_select(const FastCorners& corners, int target, cv::Size size, double tolerance_fraction = 0.001,
+                            double width_hint = 0);
 
 // Indices of `keypoints` sorted by decreasing response, ties by index (a counting sort when the
 // responses are small integers, as FAST scores are).
