@@ -396,7 +396,7 @@ SortedCandidates sort_corners(const FastCorners& corners, const CornerExtent& ex
 // slot of every non-empty run, and the run's rank is the number of marks up to the slot (a
 // prefix count per 64-bit word plus a popcount).
 inline void gather_kept_impl(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin,
-                             const int* slots, int n, FastCorners& out, Workspace& ws) {
+                             const CornerExtent& extent, const int* slots, int n, FastCorners& out, Workspace& ws) {
   out.resize(static_cast<std::size_t>(n));
   uint32_t* out_position = out.position.data();
   uint8_t* out_score = out.score.data();
@@ -405,14 +405,25 @@ inline void gather_kept_impl(const SortedCandidates& sorted, const std::array<in
   uint64_t* marks = ws.run_marks.get(words);
   int* below = ws.run_rank.get(words);
   std::fill_n(marks, words, uint64_t{0});
-  std::array<uint8_t, kScoreBins + 1> run_score;
+  std::array<uint8_t, kScoreBins + 2> run_score;
   int runs = 0;
-  for (std::size_t b = 0; b < kScoreBins; ++b) {
+  // Over the scores in use, without branches (empty bins alternate with full ones). Run starts
+  // only grow, so the current word is built in a register and stored, never read back (a
+  // read-modify-write of the same word per run would chain through store forwarding).
+  uint64_t word = 0;
+  std::size_t word_index = 0;
+  for (int sc = extent.max_score; sc >= extent.min_score; --sc) {
+    const auto b = static_cast<std::size_t>(kScoreBins - 1 - sc);
     const int first = bin_begin[b];
-    if (bin_begin[b + 1] == first) continue;
-    marks[static_cast<std::size_t>(first) >> 6] |= uint64_t{1} << (first & 63);
-    run_score[static_cast<std::size_t>(++runs)] = static_cast<uint8_t>(kScoreBins - 1 - static_cast<int>(b));
+    const bool full = bin_begin[b + 1] != first;
+    const std::size_t w = static_cast<std::size_t>(first) >> 6;
+    marks[word_index] = word;  // final once w moves on
+    word = (w == word_index ? word : 0) | uint64_t{full} << (first & 63);
+    word_index = w;
+    run_score[static_cast<std::size_t>(runs) + 1] = static_cast<uint8_t>(sc);  // kept only if full
+    runs += full;
   }
+  marks[word_index] = word;
   auto popcount = [](uint64_t v) { return __builtin_popcountll(v); };
   int total = 0;
   for (std::size_t w = 0; w < words; ++w) {
@@ -433,19 +444,20 @@ inline void gather_kept_impl(const SortedCandidates& sorted, const std::array<in
 #pragma GCC target("popcnt")
 // The same, inlined here so that the popcounts become POPCNT instructions.
 [[gnu::flatten]] void gather_kept_popcnt(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin,
-                                         const int* slots, int n, FastCorners& out, Workspace& ws) {
-  gather_kept_impl(sorted, bin_begin, slots, n, out, ws);
+                                         const CornerExtent& extent, const int* slots, int n, FastCorners& out,
+                                         Workspace& ws) {
+  gather_kept_impl(sorted, bin_begin, extent, slots, n, out, ws);
 }
 #pragma GCC pop_options
 #endif
 
-void gather_kept(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin, const int* slots, int n,
-                 FastCorners& out, Workspace& ws) {
+void gather_kept(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin, const CornerExtent& extent,
+                 const int* slots, int n, FastCorners& out, Workspace& ws) {
 #ifdef PLSLAM_SSC_AVX2
   static const bool has_popcnt = __builtin_cpu_supports("popcnt");
-  if (has_popcnt && !detail::ssc_portable_only()) return gather_kept_popcnt(sorted, bin_begin, slots, n, out, ws);
+  if (has_popcnt && !detail::ssc_portable_only()) return gather_kept_popcnt(sorted, bin_begin, extent, slots, n, out, ws);
 #endif
-  gather_kept_impl(sorted, bin_begin, slots, n, out, ws);
+  gather_kept_impl(sorted, bin_begin, extent, slots, n, out, ws);
 }
 
 // The cell of pixel coordinate x at width w is floor(2x / w) (cells of side w/2), computed as
@@ -745,13 +757,13 @@ SscCornersResult ssc_select(const FastCorners& corners, int target, cv::Size siz
   if (k <= target) {
     std::vector<int> all(static_cast<std::size_t>(k));
     std::iota(all.begin(), all.end(), 0);
-    gather_kept(sorted, bin_begin, all.data(), k, result.kept, ws);
+    gather_kept(sorted, bin_begin, extent, all.data(), k, result.kept, ws);
     return result;
   }
   const Selection sel = search_width(sorted, target, size, tolerance_fraction, width_hint, ws);
   result.width = sel.width;
   result.iterations = sel.iterations;
-  gather_kept(sorted, bin_begin, sel.slots, sel.count, result.kept, ws);
+  gather_kept(sorted, bin_begin, extent, sel.slots, sel.count, result.kept, ws);
   return result;
 }
 
