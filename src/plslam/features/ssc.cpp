@@ -347,23 +347,32 @@ CornerExtent corner_extent(const FastCorners& corners) {
   return corner_extent_portable(corners);
 }
 
+// The runs of equal scores in the sorted order, for recovering the scores of kept slots without
+// branches (walking the runs alongside the slots mispredicts at most run changes, which are
+// frequent among kept points): a bitmap marks the first slot of every non-empty run, and the
+// rank of the run holding slot s is the number of marks in [0, s] (a prefix count per 64-bit
+// word plus a popcount). run_score[r] is the score of the r-th run (from 1).
+struct ScoreRuns {
+  uint64_t* marks;  // ws.run_marks, sorted.size / 64 + 1 words
+  std::array<uint8_t, kScoreBins + 2> run_score;
+};
+
 // Corners already hold packed positions and integer scores: the counting sort reads them
 // directly (5 bytes per candidate) and scatters only positions; no index is needed, since the
 // kept corners are returned as positions and scores (gather_kept). Counters are cleared and
-// summed over the scores in use only (`extent`).
-// bin_begin[b]: first sorted slot of score 255 - b; bin_begin[256] = k.
-SortedCandidates sort_corners(const FastCorners& corners, const CornerExtent& extent, Workspace& ws,
-                              std::array<int, kScoreBins + 1>& bin_begin) {
+// summed over the scores in use only (`extent`), and the score runs are marked on the way.
+SortedCandidates sort_corners(const FastCorners& corners, const CornerExtent& extent, Workspace& ws, ScoreRuns& runs) {
   const int k = static_cast<int>(corners.size());
   uint32_t* position = ws.position.get(static_cast<std::size_t>(k));
   const SortedCandidates s{nullptr, position, k};
   const uint8_t* score = corners.score.data();
   const uint32_t* pos = corners.position.data();
-  // Four consecutive parts with their own counters, as in sort_candidates.
+  // Four consecutive parts with their own counters, as in sort_candidates; the four counters of
+  // a score are adjacent, so that the prefix sum handles a score in one 128-bit vector.
   constexpr int kParts = 4;
-  std::array<std::array<int, kScoreBins>, kParts> next;
+  alignas(16) std::array<int, kScoreBins * kParts> next;  // next[score * kParts + part]
   const int lo = extent.min_score, hi = extent.max_score;
-  for (auto& counters : next) std::fill(counters.begin() + lo, counters.begin() + hi + 1, 0);
+  std::fill(next.begin() + lo * kParts, next.begin() + (hi + 1) * kParts, 0);
   std::array<int, kParts + 1> part_begin{};
   for (int q = 0; q <= kParts; ++q) part_begin[static_cast<std::size_t>(q)] = static_cast<int>(static_cast<int64_t>(k) * q / kParts);
   const int common = k / kParts;
@@ -373,57 +382,76 @@ SortedCandidates sort_corners(const FastCorners& corners, const CornerExtent& ex
     for (int q = 0; q < kParts; ++q)
       for (int i = part_begin[static_cast<std::size_t>(q)] + common; i < part_begin[static_cast<std::size_t>(q) + 1]; ++i) f(q, i);
   };
-  for_each_part([&](int q, int i) { ++next[static_cast<std::size_t>(q)][score[i]]; });
-  // Counts -> first output slot of each (score, part), strongest score first.
-  std::fill(bin_begin.begin(), bin_begin.begin() + (kScoreBins - hi), 0);
-  int offset = 0;
-  for (int sc = hi; sc >= lo; --sc) {
-    bin_begin[static_cast<std::size_t>(kScoreBins - 1 - sc)] = offset;
-    for (std::size_t q = 0; q < kParts; ++q) {
-      const int c = next[q][static_cast<std::size_t>(sc)];
-      next[q][static_cast<std::size_t>(sc)] = offset;
-      offset += c;
+  for_each_part([&](int q, int i) { ++next[static_cast<std::size_t>(score[i] * kParts + q)]; });
+  // Counts -> first output slot of each (score, part), strongest score first; a non-empty score
+  // starts a run at its first slot. The run marks are built a word at a time in a register and
+  // stored, never read back (run starts only grow).
+  const auto words = static_cast<std::size_t>(k / 64 + 1);
+  runs.marks = ws.run_marks.get(words);
+  std::fill_n(runs.marks, words, uint64_t{0});
+  uint64_t word = 0;
+  std::size_t word_index = 0;
+  int run_count = 0;
+  auto mark_run = [&](int sc, int first, bool full) {
+    const std::size_t w = static_cast<std::size_t>(first) >> 6;
+    runs.marks[word_index] = word;  // final once w moves on
+    word = (w == word_index ? word : 0) | uint64_t{full} << (first & 63);
+    word_index = w;
+    runs.run_score[static_cast<std::size_t>(run_count) + 1] = static_cast<uint8_t>(sc);  // kept only if full
+    run_count += full;
+  };
+  // Per score the four part counts become their first output slots. The scalar loop chains four
+  // adds per score; the SSE2 one takes the exclusive prefix of the four counts in a vector and
+  // keeps the running offset in all lanes, one vector add per score on the chain. (The scalar
+  // loop also serves as the portable reference in tests.)
+  auto prefix_scalar = [&] {
+    int offset = 0;
+    for (int sc = hi; sc >= lo; --sc) {
+      const int first = offset;
+      for (int q = 0; q < kParts; ++q) {
+        int& c = next[static_cast<std::size_t>(sc * kParts + q)];
+        const int count = c;
+        c = offset;
+        offset += count;
+      }
+      mark_run(sc, first, offset != first);
     }
+  };
+#ifdef __SSE2__
+  static_assert(kParts == 4, "one 128-bit vector per score");
+  if (!detail::ssc_portable_only()) {
+    __m128i offset = _mm_setzero_si128();
+    for (int sc = hi; sc >= lo; --sc) {
+      auto* cell = reinterpret_cast<__m128i*>(next.data() + sc * kParts);
+      const __m128i c = _mm_load_si128(cell);
+      const __m128i incl2 = _mm_add_epi32(c, _mm_slli_si128(c, 4));
+      const __m128i incl = _mm_add_epi32(incl2, _mm_slli_si128(incl2, 8));  // c0, c0+c1, ...
+      _mm_store_si128(cell, _mm_add_epi32(offset, _mm_sub_epi32(incl, c)));
+      const int first = _mm_cvtsi128_si32(offset);
+      offset = _mm_add_epi32(offset, _mm_shuffle_epi32(incl, 0xFF));
+      mark_run(sc, first, _mm_cvtsi128_si32(offset) != first);
+    }
+  } else {
+    prefix_scalar();
   }
-  std::fill(bin_begin.begin() + (kScoreBins - lo), bin_begin.end(), offset);
-  for_each_part([&](int q, int i) { position[next[static_cast<std::size_t>(q)][score[i]]++] = pos[i]; });
+#else
+  prefix_scalar();
+#endif
+  runs.marks[word_index] = word;
+  for_each_part([&](int q, int i) { position[next[static_cast<std::size_t>(score[i] * kParts + q)]++] = pos[i]; });
   return s;
 }
 
-// Positions and scores of the sorted slots `slots[0, n)`. The score of a slot is that of the
-// run of equal scores holding it, found without branches (walking the runs alongside the slots
-// mispredicts at most run changes, which are frequent among kept points): a bitmap marks the first
-// slot of every non-empty run, and the run's rank is the number of marks up to the slot (a
-// prefix count per 64-bit word plus a popcount).
-inline void gather_kept_impl(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin,
-                             const CornerExtent& extent, const int* slots, int n, FastCorners& out, Workspace& ws) {
+// Positions and scores of the sorted slots `slots[0, n)` (see ScoreRuns).
+inline void gather_kept_impl(const SortedCandidates& sorted, const ScoreRuns& runs, const int* slots, int n,
+                             FastCorners& out, Workspace& ws) {
   out.resize(static_cast<std::size_t>(n));
   uint32_t* out_position = out.position.data();
   uint8_t* out_score = out.score.data();
   const uint32_t* position = sorted.position;
   const auto words = static_cast<std::size_t>(sorted.size / 64 + 1);
-  uint64_t* marks = ws.run_marks.get(words);
+  const uint64_t* marks = runs.marks;
   int* below = ws.run_rank.get(words);
-  std::fill_n(marks, words, uint64_t{0});
-  std::array<uint8_t, kScoreBins + 2> run_score;
-  int runs = 0;
-  // Over the scores in use, without branches (empty bins alternate with full ones). Run starts
-  // only grow, so the current word is built in a register and stored, never read back (a
-  // read-modify-write of the same word per run would chain through store forwarding).
-  uint64_t word = 0;
-  std::size_t word_index = 0;
-  for (int sc = extent.max_score; sc >= extent.min_score; --sc) {
-    const auto b = static_cast<std::size_t>(kScoreBins - 1 - sc);
-    const int first = bin_begin[b];
-    const bool full = bin_begin[b + 1] != first;
-    const std::size_t w = static_cast<std::size_t>(first) >> 6;
-    marks[word_index] = word;  // final once w moves on
-    word = (w == word_index ? word : 0) | uint64_t{full} << (first & 63);
-    word_index = w;
-    run_score[static_cast<std::size_t>(runs) + 1] = static_cast<uint8_t>(sc);  // kept only if full
-    runs += full;
-  }
-  marks[word_index] = word;
   auto popcount = [](uint64_t v) { return __builtin_popcountll(v); };
   int total = 0;
   for (std::size_t w = 0; w < words; ++w) {
@@ -435,7 +463,7 @@ inline void gather_kept_impl(const SortedCandidates& sorted, const std::array<in
     const std::size_t w = slot >> 6;
     const int rank = below[w] + popcount(marks[w] & (~uint64_t{0} >> (63 - (slot & 63))));
     out_position[i] = position[slot];
-    out_score[i] = run_score[static_cast<std::size_t>(rank)];
+    out_score[i] = runs.run_score[static_cast<std::size_t>(rank)];
   }
 }
 
@@ -443,21 +471,20 @@ inline void gather_kept_impl(const SortedCandidates& sorted, const std::array<in
 #pragma GCC push_options
 #pragma GCC target("popcnt")
 // The same, inlined here so that the popcounts become POPCNT instructions.
-[[gnu::flatten]] void gather_kept_popcnt(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin,
-                                         const CornerExtent& extent, const int* slots, int n, FastCorners& out,
-                                         Workspace& ws) {
-  gather_kept_impl(sorted, bin_begin, extent, slots, n, out, ws);
+[[gnu::flatten]] void gather_kept_popcnt(const SortedCandidates& sorted, const ScoreRuns& runs, const int* slots, int n,
+                                         FastCorners& out, Workspace& ws) {
+  gather_kept_impl(sorted, runs, slots, n, out, ws);
 }
 #pragma GCC pop_options
 #endif
 
-void gather_kept(const SortedCandidates& sorted, const std::array<int, kScoreBins + 1>& bin_begin, const CornerExtent& extent,
-                 const int* slots, int n, FastCorners& out, Workspace& ws) {
+void gather_kept(const SortedCandidates& sorted, const ScoreRuns& runs, const int* slots, int n, FastCorners& out,
+                 Workspace& ws) {
 #ifdef PLSLAM_SSC_AVX2
   static const bool has_popcnt = __builtin_cpu_supports("popcnt");
-  if (has_popcnt && !detail::ssc_portable_only()) return gather_kept_popcnt(sorted, bin_begin, extent, slots, n, out, ws);
+  if (has_popcnt && !detail::ssc_portable_only()) return gather_kept_popcnt(sorted, runs, slots, n, out, ws);
 #endif
-  gather_kept_impl(sorted, bin_begin, extent, slots, n, out, ws);
+  gather_kept_impl(sorted, runs, slots, n, out, ws);
 }
 
 // The cell of pixel coordinate x at width w is floor(2x / w) (cells of side w/2), computed as
@@ -752,18 +779,18 @@ SscCornersResult ssc_select(const FastCorners& corners, int target, cv::Size siz
   if (extent.max_x >= static_cast<uint32_t>(size.width) || extent.max_y >= static_cast<uint32_t>(size.height))
     throw std::invalid_argument("ssc_select: corner outside the image");
   Workspace& ws = workspace();
-  std::array<int, kScoreBins + 1> bin_begin;
-  const SortedCandidates sorted = sort_corners(corners, extent, ws, bin_begin);
+  ScoreRuns runs;
+  const SortedCandidates sorted = sort_corners(corners, extent, ws, runs);
   if (k <= target) {
     std::vector<int> all(static_cast<std::size_t>(k));
     std::iota(all.begin(), all.end(), 0);
-    gather_kept(sorted, bin_begin, extent, all.data(), k, result.kept, ws);
+    gather_kept(sorted, runs, all.data(), k, result.kept, ws);
     return result;
   }
   const Selection sel = search_width(sorted, target, size, tolerance_fraction, width_hint, ws);
   result.width = sel.width;
   result.iterations = sel.iterations;
-  gather_kept(sorted, bin_begin, extent, sel.slots, sel.count, result.kept, ws);
+  gather_kept(sorted, runs, sel.slots, sel.count, result.kept, ws);
   return result;
 }
 
