@@ -65,7 +65,8 @@ TEST(Quadtree, DeterministicAndSmallInputs) {
 }
 
 TEST(Quadtree, CornersGiveTheKeypointSelection) {
-  for (const cv::Size size : {cv::Size(752, 480), cv::Size(1226, 370), cv::Size(97, 61)}) {
+  // Column widths that are whole (1200 / 3) and not, and many initial columns (3000 / 300).
+  for (const cv::Size size : {cv::Size(752, 480), cv::Size(1226, 370), cv::Size(1200, 400), cv::Size(97, 61), cv::Size(3000, 300)}) {
     const auto kps = clustered_keypoints(size.area() / 30, size, 4u + static_cast<uint32_t>(size.width));
     const FastCorners corners = FastCorners::from_keypoints(kps);
     for (const int target : {1, 37, 400, 1200})

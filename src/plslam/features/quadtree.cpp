@@ -15,21 +15,55 @@ struct Node {
   int size() const { return end - begin; }
 };
 
-// Point access to the two input layouts.
+// Point access to the two input layouts. quadrants(xm, ym) gives the child of a point of a node
+// split at (xm, ym): 0 top-left, 1 top-right, 2 bottom-left, 3 bottom-right.
 struct KeyPointInput {
   const std::vector<cv::KeyPoint>& kps;
   std::size_t size() const { return kps.size(); }
-  cv::Point2f point(int i) const { return kps[static_cast<std::size_t>(i)].pt; }
   float response(int i) const { return kps[static_cast<std::size_t>(i)].response; }
+  // The initial column of a point: columns of width hx.
+  auto columns(float hx, int n) const {
+    return [this, hx, n](int i) { return std::clamp(static_cast<int>(kps[static_cast<std::size_t>(i)].pt.x / hx), 0, n - 1); };
+  }
+  auto quadrants(float xm, float ym) const {
+    return [this, xm, ym](int i) {
+      const cv::Point2f& p = kps[static_cast<std::size_t>(i)].pt;
+      return (p.x < xm ? 0 : 1) + (p.y < ym ? 0 : 2);
+    };
+  }
 };
+// Whole-pixel positions: x < xm exactly when x < ceil(xm), and y < ym when the packed y << 16 | x
+// is below ceil(ym) << 16, so the split compares integers without converting the points.
 struct CornerInput {
   const FastCorners& corners;
   std::size_t size() const { return corners.size(); }
-  cv::Point2f point(int i) const {
-    const uint32_t p = corners.position[static_cast<std::size_t>(i)];
-    return {static_cast<float>(FastCorners::x_of(p)), static_cast<float>(FastCorners::y_of(p))};
-  }
   int response(int i) const { return corners.score[static_cast<std::size_t>(i)]; }
+  // As KeyPointInput::columns, by the first whole x of every column (the float formula is
+  // monotone in x), so that no point is converted to float.
+  auto columns(float hx, int n) const {
+    auto column_of = [hx, n](int x) { return std::clamp(static_cast<int>(static_cast<float>(x) / hx), 0, n - 1); };
+    std::vector<int> first(static_cast<std::size_t>(std::max(0, n - 1)));
+    for (int c = 1; c < n; ++c) {
+      int x = std::max(0, static_cast<int>(static_cast<float>(c) * hx) - 2);
+      while (column_of(x) < c) ++x;
+      while (x > 0 && column_of(x - 1) >= c) --x;
+      first[static_cast<std::size_t>(c - 1)] = x;
+    }
+    return [p = corners.position.data(), first = std::move(first)](int i) {
+      const int x = FastCorners::x_of(p[i]);
+      int c = 0;
+      for (const int f : first) c += x >= f;
+      return c;
+    };
+  }
+  auto quadrants(float xm, float ym) const {
+    const auto x_split = static_cast<uint32_t>(std::ceil(xm));
+    const uint64_t packed_split = static_cast<uint64_t>(std::ceil(ym)) << 16;
+    return [p = corners.position.data(), x_split, packed_split](int i) {
+      const uint32_t v = p[i];
+      return static_cast<int>((v & 0xFFFFu) >= x_split) + 2 * static_cast<int>(v >= packed_split);
+    };
+  }
 };
 
 template <class Input>
@@ -41,17 +75,15 @@ class QuadTree {
   // hold more than one point (the ones that may split again).
   int split(const Node& n, std::vector<Node>& out) {
     const float xm = 0.5f * (n.x0 + n.x1), ym = 0.5f * (n.y0 + n.y1);
+    const auto quadrant = in_.quadrants(xm, ym);
     std::array<int, 4> count{};
     scratch_.resize(static_cast<std::size_t>(n.size()));
-    for (int i = n.begin; i < n.end; ++i) {
-      const cv::Point2f p = in_.point(idx_[static_cast<std::size_t>(i)]);
-      ++count[static_cast<std::size_t>(quadrant(p, xm, ym))];
-    }
+    for (int i = n.begin; i < n.end; ++i) ++count[static_cast<std::size_t>(quadrant(idx_[static_cast<std::size_t>(i)]))];
     std::array<int, 4> pos{0, count[0], count[0] + count[1], count[0] + count[1] + count[2]};
     const std::array<int, 4> first = pos;
     for (int i = n.begin; i < n.end; ++i) {
       const int id = idx_[static_cast<std::size_t>(i)];
-      const int q = quadrant(in_.point(id), xm, ym);
+      const int q = quadrant(id);
       scratch_[static_cast<std::size_t>(pos[static_cast<std::size_t>(q)]++)] = id;
     }
     std::copy(scratch_.begin(), scratch_.end(), idx_.begin() + n.begin);
@@ -70,9 +102,6 @@ class QuadTree {
   std::vector<int> idx_;
 
  private:
-  static int quadrant(const cv::Point2f& p, float xm, float ym) {
-    return (p.x < xm ? 0 : 1) + (p.y < ym ? 0 : 2);
-  }
   const Input& in_;
   std::vector<int> scratch_;
 };
@@ -86,8 +115,9 @@ std::vector<int> select(const Input& in, int target, cv::Size size) {
   const int n_ini = std::max(1, static_cast<int>(std::lround(static_cast<double>(size.width) / size.height)));
   const float hx = static_cast<float>(size.width) / static_cast<float>(n_ini);
   std::vector<std::vector<int>> columns(static_cast<std::size_t>(n_ini));
+  const auto column_of = in.columns(hx, n_ini);
   for (int i = 0; i < k; ++i) {
-    const int c = std::clamp(static_cast<int>(in.point(i).x / hx), 0, n_ini - 1);
+    const int c = column_of(i);
     columns[static_cast<std::size_t>(c)].push_back(i);
   }
   std::vector<Node> nodes, next;
