@@ -395,7 +395,9 @@ SortedCandidates sort_corners(const FastCorners& corners, const CornerExtent& ex
   auto mark_run = [&](int sc, int first, bool full) {
     const std::size_t w = static_cast<std::size_t>(first) >> 6;
     runs.marks[word_index] = word;  // final once w moves on
-    word = (w == word_index ? word : 0) | uint64_t{full} << (first & 63);
+    // Keeps the word while w stays (a mask, not a branch: w moves on at unpredictable scores).
+    const uint64_t stay = uint64_t{0} - static_cast<uint64_t>(w == word_index);
+    word = (word & stay) | uint64_t{full} << (first & 63);
     word_index = w;
     runs.run_score[static_cast<std::size_t>(run_count) + 1] = static_cast<uint8_t>(sc);  // kept only if full
     run_count += full;
