@@ -140,11 +140,16 @@ Workspace& workspace() {
 
 // Candidates in visiting order (strongest first): original index and integer pixel position
 // packed as y << 16 | x. The covering works on whole pixels (FAST corners are whole pixels).
+// `position` is followed by kPadding entries of pixel (0, 0) (pad_sorted), so that a scan can
+// read its last block whole and mask the bits past the end instead of finishing one candidate
+// at a time.
 struct SortedCandidates {
   const int* index;
   const uint32_t* position;
   int size;
 };
+constexpr int kPadding = 64;
+void pad_sorted(uint32_t* position, int size) { std::fill_n(position + size, kPadding, uint32_t{0}); }
 
 constexpr int kScoreBins = 256;  // FAST scores are below 256
 
@@ -221,7 +226,8 @@ SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv:
   const int k = static_cast<int>(keypoints.size());
   const auto n = static_cast<std::size_t>(k);
   int* index = ws.index.get(n);
-  uint32_t* position = ws.position.get(n);
+  uint32_t* position = ws.position.get(n + kPadding);
+  pad_sorted(position, k);
   const SortedCandidates s{index, position, k};
   // Counting sort on integer scores (FAST's), descending and stable. The keypoints (28 bytes
   // each) are read once into compact bins and positions; counting and scattering work on those.
@@ -363,7 +369,8 @@ struct ScoreRuns {
 // summed over the scores in use only (`extent`), and the score runs are marked on the way.
 SortedCandidates sort_corners(const FastCorners& corners, const CornerExtent& extent, Workspace& ws, ScoreRuns& runs) {
   const int k = static_cast<int>(corners.size());
-  uint32_t* position = ws.position.get(static_cast<std::size_t>(k));
+  uint32_t* position = ws.position.get(static_cast<std::size_t>(k) + kPadding);
+  pad_sorted(position, k);
   const SortedCandidates s{nullptr, position, k};
   const uint8_t* score = corners.score.data();
   const uint32_t* pos = corners.position.data();
@@ -512,9 +519,6 @@ struct Grid {
         two_over_w(2.0f / static_cast<float>(width)),
         cells(static_cast<std::size_t>(stride) * static_cast<std::size_t>(rows + 4)) {}
   int cell_of_coordinate(uint32_t x) const { return cell_of(x, two_over_w); }
-  int cell(uint32_t packed) const {
-    return (cell_of(packed >> 16, two_over_w) + 2) * stride + cell_of(packed & 0xFFFFu, two_over_w) + 2;
-  }
 };
 
 // Covers the 5x5 cells around `cell` with `stamp`: per row a 4-byte and a 1-byte store. Plain
@@ -559,8 +563,8 @@ int scan_portable(const SortedCandidates& sorted, const Grid& grid, cv::Size siz
   const int n = sorted.size;
   int count = 0;
   constexpr int kBlock = 32;
-  int i = 0;
-  for (; i + kBlock <= n; i += kBlock) {
+  static_assert(kBlock <= kPadding);
+  for (int i = 0; i < n; i += kBlock) {
     std::array<int, kBlock> cells;
     uint32_t free_mask = 0;
 #pragma GCC unroll 32
@@ -570,14 +574,8 @@ int scan_portable(const SortedCandidates& sorted, const Grid& grid, cv::Size siz
       cells[static_cast<std::size_t>(j)] = c;
       free_mask |= static_cast<uint32_t>(g[c] != stamp) << j;
     }
+    if (n - i < kBlock) free_mask &= (uint32_t{1} << (n - i)) - 1u;  // the padding past the end
     if (!keep_free(free_mask, cells.data(), i, g, grid.stride, stamp, limit, kept, count)) return count;
-  }
-  for (; i < n; ++i) {
-    uint8_t* cell = g + ry[p[i] >> 16] + cx[p[i] & 0xFFFFu];
-    if (*cell == stamp) continue;
-    kept[count++] = i;
-    if (count >= limit) break;
-    mark_cover(cell, grid.stride, stamp);
   }
   return count;
 }
@@ -595,8 +593,8 @@ int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, uint
   const __m256 quarter = _mm256_set1_ps(0.25f), scale = _mm256_set1_ps(grid.two_over_w);
   int count = 0;
   constexpr int kBlock = 64;
-  int i = 0;
-  for (; i + kBlock <= n; i += kBlock) {
+  static_assert(kBlock <= kPadding);
+  for (int i = 0; i < n; i += kBlock) {
     alignas(32) int cells[kBlock];
     uint64_t free_mask = 0;
     for (int h = 0; h < kBlock / 8; ++h) {
@@ -610,14 +608,8 @@ int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, uint
       const auto bits = static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(state, covered))));
       free_mask |= static_cast<uint64_t>(~bits & 0xFFu) << (8 * h);
     }
+    if (n - i < kBlock) free_mask &= (uint64_t{1} << (n - i)) - 1u;  // the padding past the end
     if (!keep_free(free_mask, cells, i, g, grid.stride, stamp, limit, kept, count)) return count;
-  }
-  for (; i < n; ++i) {
-    uint8_t* cell = g + grid.cell(p[i]);
-    if (*cell == stamp) continue;
-    kept[count++] = i;
-    if (count >= limit) break;
-    mark_cover(cell, grid.stride, stamp);
   }
   return count;
 }
