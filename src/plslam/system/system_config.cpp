@@ -38,6 +38,12 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
   tracking.get("motion_radius", o.tracker.motion_radius);
   tracking.get("local_map_radius", o.tracker.local_map_radius);
   tracking.get("line_radius", o.tracker.line_radius);
+  tracking.get("motion_min_inlier_share", o.tracker.motion_min_inlier_share);
+  if (!(o.tracker.motion_min_inlier_share >= 0 && o.tracker.motion_min_inlier_share <= 1))
+    throw InputError(config.source(), "tracking.motion_min_inlier_share: must be in [0, 1]");
+  tracking.get("motion_retry_scale", o.tracker.motion_retry_scale);
+  if (!(o.tracker.motion_retry_scale >= 1))
+    throw InputError(config.source(), "tracking.motion_retry_scale: must be >= 1");
   tracking.get("min_local_inliers", o.tracker.min_local_inliers);
 
   const auto kf = config.section("keyframe");

@@ -187,25 +187,43 @@ int Tracker::optimize_pose(Frame& f, TrackStageTimes& t) {
 
 bool Tracker::track_with_motion_model(Frame& f, TrackStageTimes& t) {
   const auto t0 = Clock::now();
-  f.T_cw = (*velocity_ * last_->T_cw).normalized();
-  int n = search_points_from_frame(f, *last_, options_.motion_radius, options_.search);
-  if (n < options_.min_motion_matches) {
-    std::fill(f.points.begin(), f.points.end(), nullptr);
-    n = search_points_from_frame(f, *last_, 2 * options_.motion_radius, options_.search);
-  }
+  const geometry::SE3 predicted = (*velocity_ * last_->T_cw).normalized();
+  std::vector<map::MapLine*> last_lines;
   if (options_.lines) {
-    std::vector<map::MapLine*> last_lines;
     for (std::size_t j = 0; j < last_->lines.size(); ++j) {
       if (last_->lines[j] && !last_->line_outlier[j]) last_lines.push_back(last_->lines[j]);
     }
-    n += search_lines(f, last_lines, options_.line_radius, options_.search);
   }
-  bool ok = false;
-  if (n >= options_.min_motion_matches) {
-    const int inliers = optimize_pose(f, t);
-    f.discard_outliers();
-    ok = inliers >= options_.min_pose_inliers;
+  // One attempt: search the last frame's matches around the prediction within `scale` times
+  // the normal windows, then optimise. Returns the matches found; `inliers` is 0 when too few.
+  auto attempt = [&](double scale, int& inliers) {
+    f.T_cw = predicted;
+    std::fill(f.points.begin(), f.points.end(), nullptr);
+    std::fill(f.lines.begin(), f.lines.end(), nullptr);
+    int n = search_points_from_frame(f, *last_, scale * options_.motion_radius, options_.search);
+    if (options_.lines) n += search_lines(f, last_lines, scale * options_.line_radius, options_.search);
+    inliers = n >= options_.min_motion_matches ? optimize_pose(f, t) : 0;
+    return n;
+  };
+  int inliers = 0;
+  int n = attempt(1.0, inliers);
+  if (n < options_.min_motion_matches) n = attempt(2.0, inliers);  // ORB-SLAM2's second window
+  // A sudden change of motion (a car entering a turn: 1 degree of unexpected yaw is 12 px on
+  // KITTI) moves most true matches out of the window. The matches found are then mostly wrong,
+  // and the optimisation, pulled between them, keeps few as inliers and settles on a wrong pose
+  // that local map tracking would confirm. So a low inlier share means: search again in a window
+  // wide enough for the change and keep whichever attempt explains more matches.
+  if (n >= options_.min_motion_matches && inliers < options_.motion_min_inlier_share * n) {
+    const Frame narrow = f;
+    const int narrow_inliers = inliers;
+    attempt(options_.motion_retry_scale, inliers);
+    if (inliers <= narrow_inliers) {
+      f = narrow;
+      inliers = narrow_inliers;
+    }
   }
+  f.discard_outliers();
+  const bool ok = inliers >= options_.min_pose_inliers;
   if (!ok) {
     std::fill(f.points.begin(), f.points.end(), nullptr);
     std::fill(f.lines.begin(), f.lines.end(), nullptr);

@@ -27,6 +27,10 @@ struct TrackerOptions {
   double motion_radius = 7.0;         // px at level 0, motion-model search (ORB-SLAM2 stereo)
   double local_map_radius = 1.0;      // px factor, local-map search (times 2.5 or 4 and the level scale)
   double line_radius = 8.0;           // px, line search
+  // Motion-model tracking searches again in windows `motion_retry_scale` times wider when fewer
+  // than this share of its matches survive the pose optimisation (the motion changed suddenly).
+  double motion_min_inlier_share = 0.5;
+  double motion_retry_scale = 4.0;
   int min_motion_matches = 20;
   int min_pose_inliers = 10;
   int min_local_inliers = 30;
