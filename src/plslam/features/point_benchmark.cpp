@@ -77,7 +77,7 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
 
   const std::size_t frames = options.max_frames > 0 ? std::min(options.max_frames, dataset.size()) : dataset.size();
   const SingleThreadedOpenCv single_thread;
-  std::vector<double> pyramid_ms, fast_ms, ssc_ms, quadtree_ms, orb_ms, left_ms, right_ms, stereo_ms;
+  std::vector<double> pyramid_ms, fast_ms, ssc_ms, quadtree_ms, ssc_first_ms, quadtree_first_ms, orb_ms, left_ms, right_ms, stereo_ms;
   std::vector<double> candidates, kept_ssc, kept_quadtree, matches, match_share, cv_ssc, cv_quadtree;
   cv::Size size;
   for (std::size_t i = 0; i < frames; ++i) {
@@ -92,27 +92,33 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
       t0 = Clock::now();
       const PyramidCandidates cand = left_extractor.detect(left.pyramid);
       const double t_fast = ms_since(t0);
-      // SSC and quadtree on the same candidates; whichever runs second finds them in cache, so
-      // the order alternates between frames.
+      // SSC and quadtree on the same candidates, `distribution_repeats` times each with the order
+      // alternating (whichever runs second finds the candidates in cache); the frame's time for
+      // each is the median of its repeats, so that one interrupted run does not decide a ratio
+      // of two sub-millisecond stages.
       PyramidCandidates ssc, quad;
-      double t_ssc = 0, t_quad = 0;
+      std::vector<double> ssc_reps, quad_reps;
       auto run_ssc = [&] {
         const auto t = Clock::now();
         ssc = left_extractor.distribute(cand, Distribution::kSsc);
-        t_ssc = ms_since(t);
+        ssc_reps.push_back(ms_since(t));
       };
       auto run_quadtree = [&] {
         const auto t = Clock::now();
         quad = left_extractor.distribute(cand, Distribution::kQuadtree);
-        t_quad = ms_since(t);
+        quad_reps.push_back(ms_since(t));
       };
-      if (i % 2 == 0) {
-        run_ssc();
-        run_quadtree();
-      } else {
-        run_quadtree();
-        run_ssc();
+      const int repeats = std::max(1, options.distribution_repeats);
+      for (int r = 0; r < repeats; ++r) {
+        if ((i + static_cast<std::size_t>(r)) % 2 == 0) {
+          run_ssc();
+          run_quadtree();
+        } else {
+          run_quadtree();
+          run_ssc();
+        }
       }
+      const double t_ssc = percentile(ssc_reps, 0.5), t_quad = percentile(quad_reps, 0.5);
       t0 = Clock::now();
       left_extractor.describe(left.pyramid, ssc, left);
       const double t_orb = ms_since(t0);
@@ -127,6 +133,8 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
       fast_ms.push_back(t_fast);
       ssc_ms.push_back(t_ssc);
       quadtree_ms.push_back(t_quad);
+      ssc_first_ms.push_back(ssc_reps.front());
+      quadtree_first_ms.push_back(quad_reps.front());
       orb_ms.push_back(t_orb);
       left_ms.push_back(t_pyr + t_fast + t_ssc + t_orb);
       right_ms.push_back(t_right);
@@ -158,6 +166,7 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
                  {"fast_min_threshold", orb.fast_min_threshold},
                  {"fast_impl", to_string(resolve_fast_impl(orb.fast_impl))},
                  {"ssc_tolerance", orb.ssc_tolerance},
+                 {"distribution_repeats", std::max(1, options.distribution_repeats)},
                  {"right_feature_factor", options.right_feature_factor}};
   j["pyramid_ms"] = summarize(pyramid_ms);
   j["fast_ms"] = summarize(fast_ms);
@@ -167,8 +176,14 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
   j["left_extract_ms"] = summarize(left_ms);
   j["right_extract_ms"] = summarize(right_ms);
   j["stereo_points_ms"] = summarize(stereo_ms);
-  const double ssc_median = j["ssc_ms"]["median"].is_number() ? j["ssc_ms"]["median"].get<double>() : 0.0;
-  j["ssc_speedup"] = ssc_median > 0 ? j["quadtree_ms"]["median"].get<double>() / ssc_median : 0.0;
+  // quadtree / SSC, medians over frames: of the per-frame medians of the repeats, and of the
+  // first run of each per frame (colder caches; what a single timing per frame sees).
+  const auto speedup = [](const std::vector<double>& quad, const std::vector<double>& ssc) {
+    const double s = percentile(ssc, 0.5);
+    return s > 0 ? percentile(quad, 0.5) / s : 0.0;
+  };
+  j["ssc_speedup"] = speedup(quadtree_ms, ssc_ms);
+  j["ssc_speedup_first_run"] = speedup(quadtree_first_ms, ssc_first_ms);
   j["keypoints"] = summarize(kept_ssc);
   j["keypoints"]["fast_candidates"] = summarize(candidates);
   j["keypoints"]["quadtree"] = summarize(kept_quadtree);

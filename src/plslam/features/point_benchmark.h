@@ -13,6 +13,7 @@ namespace plslam::features {
 
 struct PointBenchmarkOptions {
   std::size_t max_frames = 0;     // 0: every frame of the dataset
+  int distribution_repeats = 5;   // SSC and quadtree timings per frame: median of this many runs
   int n_features = 0;             // 0: 1200 for EuRoC, 2000 for KITTI
   OrbOptions orb;                 // n_features is overridden as above
   double right_feature_factor = 2.0;

@@ -111,8 +111,7 @@ class Scratch {
 struct Workspace {
   Scratch<int> index, col_of_x, row_of_y;
   std::array<Scratch<int>, 2> kept;  // the current pass and the best one so far
-  Scratch<uint32_t> pos, position;
-  Scratch<uint8_t> bin;
+  Scratch<uint32_t> position;
   Scratch<uint64_t> run_marks;  // gather_kept's run starts
   Scratch<int> run_rank;
   // The cover grid of a pass: a cell is covered when it holds the pass's stamp, so that a new
@@ -153,126 +152,25 @@ void pad_sorted(uint32_t* position, int size) { std::fill_n(position + size, kPa
 
 constexpr int kScoreBins = 256;  // FAST scores are below 256
 
-// Reads keypoint i into its score bin (255 - score: strongest first) and packed position,
-// clamped into the image. Returns false when the response is not an integer in [0, 256).
-bool convert_one(const cv::KeyPoint& kp, float x_max, float y_max, uint8_t& bin, uint32_t& pos) {
-  // Clamped as floats, NaN to 0, so the integer conversions are always defined.
-  const float x = std::min(kp.pt.x > 0.f ? kp.pt.x : 0.f, x_max);
-  const float y = std::min(kp.pt.y > 0.f ? kp.pt.y : 0.f, y_max);
-  pos = static_cast<uint32_t>(y) << 16 | static_cast<uint32_t>(x);
-  const float r = kp.response;
-  const float in_range = (r >= 0.f && r < static_cast<float>(kScoreBins)) ? r : 0.f;  // false for NaN too
-  const int ri = static_cast<int>(in_range);
-  bin = static_cast<uint8_t>(kScoreBins - 1 - ri);
-  // Integer test by conversion: std::floor is a library call without SSE4.1.
-  return static_cast<float>(ri) == r;
-}
-
-// Bins and positions of all keypoints (as convert_one), four at a time with SSE2: the 28-byte
-// keypoints are transposed in registers. Returns false when some response is not an integer
-// score.
-bool convert_all(const std::vector<cv::KeyPoint>& keypoints, cv::Size size, uint8_t* bin, uint32_t* pos, int& min_bin,
-                 int& max_bin) {
-  const int k = static_cast<int>(keypoints.size());
-  const auto x_max = static_cast<float>(size.width - 1), y_max = static_cast<float>(size.height - 1);
-  int i = 0;
-  bool ok = true;
-#ifdef __SSE2__
-  static_assert(sizeof(cv::KeyPoint) == 28 && offsetof(cv::KeyPoint, pt) == 0 && offsetof(cv::KeyPoint, response) == 16,
-                "cv::KeyPoint layout");
-  const char* base = reinterpret_cast<const char*>(keypoints.data());
-  const __m128 zero = _mm_setzero_ps(), vx_max = _mm_set1_ps(x_max), vy_max = _mm_set1_ps(y_max);
-  const __m128 r_end = _mm_set1_ps(static_cast<float>(kScoreBins));
-  const __m128i top_bin = _mm_set1_epi32(kScoreBins - 1);
-  __m128 all_ok = _mm_castsi128_ps(_mm_set1_epi32(-1));
-  __m128i lo_bin = _mm_set1_epi16(kScoreBins - 1), hi_bin = _mm_setzero_si128();
-  auto load = [&](int j, int byte) { return _mm_loadu_ps(reinterpret_cast<const float*>(base + 28 * j + byte)); };
-  // The response load of keypoint i+3 reads 12 bytes into keypoint i+4, which must exist.
-  for (; i + 5 <= k; i += 4) {
-    const __m128 xy01 = _mm_unpacklo_ps(load(i, 0), load(i + 1, 0));      // x0 x1 y0 y1
-    const __m128 xy23 = _mm_unpacklo_ps(load(i + 2, 0), load(i + 3, 0));  // x2 x3 y2 y3
-    const __m128 x = _mm_movelh_ps(xy01, xy23), y = _mm_movehl_ps(xy23, xy01);
-    const __m128 r = _mm_movelh_ps(_mm_unpacklo_ps(load(i, 16), load(i + 1, 16)), _mm_unpacklo_ps(load(i + 2, 16), load(i + 3, 16)));
-    // max_ps returns its second operand when the first is NaN, like `v > 0 ? v : 0`.
-    const __m128i xi = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, zero), vx_max));
-    const __m128i yi = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(y, zero), vy_max));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(pos + i), _mm_or_si128(_mm_slli_epi32(yi, 16), xi));
-    const __m128 in_range = _mm_and_ps(_mm_cmpge_ps(r, zero), _mm_cmplt_ps(r, r_end));
-    const __m128i ri = _mm_cvttps_epi32(_mm_and_ps(in_range, r));
-    all_ok = _mm_and_ps(all_ok, _mm_cmpeq_ps(_mm_cvtepi32_ps(ri), r));
-    const __m128i b32 = _mm_sub_epi32(top_bin, ri);
-    const __m128i b16 = _mm_packs_epi32(b32, b32);
-    lo_bin = _mm_min_epi16(lo_bin, b16);
-    hi_bin = _mm_max_epi16(hi_bin, b16);
-    const int b8 = _mm_cvtsi128_si32(_mm_packus_epi16(b16, b16));
-    std::memcpy(bin + i, &b8, 4);
-  }
-  ok = _mm_movemask_ps(all_ok) == 0xF;
-  alignas(16) std::array<int16_t, 8> lo{}, hi{};
-  _mm_store_si128(reinterpret_cast<__m128i*>(lo.data()), lo_bin);
-  _mm_store_si128(reinterpret_cast<__m128i*>(hi.data()), hi_bin);
-  min_bin = std::min<int>(min_bin, *std::min_element(lo.begin(), lo.end()));
-  max_bin = std::max<int>(max_bin, *std::max_element(hi.begin(), hi.end()));
-#endif
-  for (; i < k; ++i) {
-    ok &= convert_one(keypoints[static_cast<std::size_t>(i)], x_max, y_max, bin[i], pos[i]);
-    min_bin = std::min<int>(min_bin, bin[i]);
-    max_bin = std::max<int>(max_bin, bin[i]);
-  }
-  return ok;
-}
-
+// The keypoint path's visiting order and positions (generic callers and tests; the extractor
+// passes FastCorners): order_by_response, and whole pixels clamped into the image as floats, NaN
+// to 0, so that the integer conversions are always defined.
 SortedCandidates sort_candidates(const std::vector<cv::KeyPoint>& keypoints, cv::Size size, Workspace& ws) {
   const int k = static_cast<int>(keypoints.size());
   const auto n = static_cast<std::size_t>(k);
   int* index = ws.index.get(n);
   uint32_t* position = ws.position.get(n + kPadding);
   pad_sorted(position, k);
-  const SortedCandidates s{index, position, k};
-  // Counting sort on integer scores (FAST's), descending and stable. The keypoints (28 bytes
-  // each) are read once into compact bins and positions; counting and scattering work on those.
-  uint8_t* bin = ws.bin.get(n);
-  uint32_t* pos = ws.pos.get(n);
-  int min_bin = kScoreBins - 1, max_bin = 0;  // the bins in use, for the offsets
-  if (!convert_all(keypoints, size, bin, pos, min_bin, max_bin)) {
-    const std::vector<int> order = order_by_response(keypoints);
-    for (std::size_t i = 0; i < n; ++i) {
-      index[i] = order[i];
-      position[i] = pos[order[i]];
-    }
-    return s;
+  const auto x_max = static_cast<float>(size.width - 1), y_max = static_cast<float>(size.height - 1);
+  const std::vector<int> order = order_by_response(keypoints);
+  for (std::size_t i = 0; i < n; ++i) {
+    const cv::Point2f& pt = keypoints[static_cast<std::size_t>(order[i])].pt;
+    const float x = std::min(pt.x > 0.f ? pt.x : 0.f, x_max);
+    const float y = std::min(pt.y > 0.f ? pt.y : 0.f, y_max);
+    index[i] = order[i];
+    position[i] = FastCorners::pack(static_cast<int>(x), static_cast<int>(y));
   }
-  // FAST scores crowd into a few bins, so one counter per bin would chain every increment
-  // through the same memory word; instead the input is split into four consecutive parts with
-  // their own counters (four independent chains). Stability holds because part q's run of a
-  // bin is placed after the runs of parts 0..q-1.
-  constexpr int kParts = 4;
-  std::array<std::array<int, kScoreBins>, kParts> next{};
-  std::array<int, kParts + 1> part_begin{};
-  for (int q = 0; q <= kParts; ++q) part_begin[static_cast<std::size_t>(q)] = static_cast<int>(static_cast<int64_t>(k) * q / kParts);
-  const int common = k / kParts;  // every part has at least this many
-  // Runs f(q, i) over all parts, interleaved.
-  auto for_each_part = [&](auto&& f) {
-    for (int j = 0; j < common; ++j)
-      for (int q = 0; q < kParts; ++q) f(q, part_begin[static_cast<std::size_t>(q)] + j);
-    for (int q = 0; q < kParts; ++q)
-      for (int i = part_begin[static_cast<std::size_t>(q)] + common; i < part_begin[static_cast<std::size_t>(q) + 1]; ++i) f(q, i);
-  };
-  for_each_part([&](int q, int i) { ++next[static_cast<std::size_t>(q)][bin[i]]; });
-  // Counts -> first output slot of each (bin, part), bins outermost.
-  int offset = 0;
-  for (auto b = static_cast<std::size_t>(min_bin); b <= static_cast<std::size_t>(max_bin); ++b)
-    for (std::size_t q = 0; q < kParts; ++q) {
-      const int c = next[q][b];
-      next[q][b] = offset;
-      offset += c;
-    }
-  for_each_part([&](int q, int i) {
-    const int dst = next[static_cast<std::size_t>(q)][bin[i]]++;
-    index[dst] = i;
-    position[dst] = pos[i];
-  });
-  return s;
+  return {index, position, k};
 }
 
 // The extent of a corner set: largest x and y, smallest and largest score.
