@@ -2,6 +2,7 @@
 // determinism, and the closed-form width bounds.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <random>
 #include <set>
 #include <sstream>
@@ -51,6 +52,20 @@ std::vector<cv::KeyPoint> subset(const std::vector<cv::KeyPoint>& kps, const std
   std::vector<cv::KeyPoint> out;
   for (int i : idx) out.push_back(kps[static_cast<std::size_t>(i)]);
   return out;
+}
+
+// FAST candidates of one real left image, with the extractor configured for its dataset.
+struct RealCandidates {
+  OrbExtractor extractor;
+  PyramidCandidates candidates;
+};
+RealCandidates real_candidates(const std::filesystem::path& data, const std::string& seq, bool middle_frame) {
+  const auto ds = io::open_dataset(data / seq);
+  OrbExtractor ex(seq.find("kitti") != std::string::npos ? OrbOptions::kitti() : OrbOptions::euroc());
+  ImagePyramid p;
+  ex.build_pyramid(ds->load(middle_frame ? ds->size() / 2 : 0).left, p);
+  PyramidCandidates cand = ex.detect(p);
+  return {std::move(ex), std::move(cand)};
 }
 
 TEST(Ssc, CountWithinToleranceAndSpacingAboveWidth) {
@@ -212,11 +227,7 @@ TEST(Ssc, VectorAndPortableScansAgree) {
 TEST(Ssc, RealPyramidCandidatesVectorAndPortableAgreeWithGuarantees) {
   PLSLAM_REQUIRE_SHARED_DATA(data);
   for (const char* seq : {"kitti/sequences/06", "euroc/V1_01_easy_micro"}) {
-    const auto ds = io::open_dataset(data / seq);
-    const OrbExtractor ex(std::string(seq).find("kitti") != std::string::npos ? OrbOptions::kitti() : OrbOptions::euroc());
-    ImagePyramid p;
-    ex.build_pyramid(ds->load(0).left, p);
-    const PyramidCandidates cand = ex.detect(p);
+    const auto [ex, cand] = real_candidates(data, seq, false);
     const std::vector<int> targets = ex.level_targets(cand);
     for (std::size_t l = 0; l < cand.size(); ++l) {
       const std::vector<cv::KeyPoint> kps = cand[l].corners.keypoints();
@@ -291,11 +302,7 @@ TEST(Ssc, CornersGiveTheKeypointSelection) {
 TEST(Ssc, CornersOfRealPyramidsGiveTheKeypointSelection) {
   PLSLAM_REQUIRE_SHARED_DATA(data);
   for (const char* seq : {"kitti/sequences/06", "euroc/V1_01_easy_micro"}) {
-    const auto ds = io::open_dataset(data / seq);
-    const OrbExtractor ex(std::string(seq).find("kitti") != std::string::npos ? OrbOptions::kitti() : OrbOptions::euroc());
-    ImagePyramid p;
-    ex.build_pyramid(ds->load(ds->size() / 2).left, p);
-    const PyramidCandidates cand = ex.detect(p);
+    const auto [ex, cand] = real_candidates(data, seq, true);
     const std::vector<int> targets = ex.level_targets(cand);
     for (std::size_t l = 0; l < cand.size(); ++l)
       for (const double hint : {0.0, 11.0})
