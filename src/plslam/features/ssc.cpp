@@ -137,8 +137,8 @@ Workspace& workspace() {
   return w;
 }
 
-// Candidates in visiting order (strongest first): original index and integer pixel position
-// packed as y << 16 | x. The covering works on whole pixels (FAST corners are whole pixels).
+// Candidates in visiting order (strongest first): original index (keypoint path only; null for
+// corners) and integer pixel position packed as y << 16 | x. The covering works on whole pixels (FAST corners are whole pixels).
 // `position` is followed by kPadding entries of pixel (0, 0) (pad_sorted), so that a scan can
 // read its last block whole and mask the bits past the end instead of finishing one candidate
 // at a time.
@@ -272,8 +272,11 @@ SortedCandidates sort_corners(const FastCorners& corners, const CornerExtent& ex
   const SortedCandidates s{nullptr, position, k};
   const uint8_t* score = corners.score.data();
   const uint32_t* pos = corners.position.data();
-  // Four consecutive parts with their own counters, as in sort_candidates; the four counters of
-  // a score are adjacent, so that the prefix sum handles a score in one 128-bit vector.
+  // FAST scores crowd into a few values, so one counter per score would chain every increment
+  // through the same memory word: the input is split into four consecutive parts with their own
+  // counters (four independent chains; stable, since part q's run of a score is placed after the
+  // runs of parts 0..q-1). The four counters of a score are adjacent, so that the prefix sum
+  // handles a score in one 128-bit vector.
   constexpr int kParts = 4;
   alignas(16) std::array<int, kScoreBins * kParts> next;  // next[score * kParts + part]
   const int lo = extent.min_score, hi = extent.max_score;

@@ -1,5 +1,7 @@
 #include "plslam/system/slam_system.h"
 
+#include "plslam/core/stopwatch.h"
+
 #include <algorithm>
 #include <chrono>
 
@@ -50,7 +52,7 @@ FrameResult System::process(const io::StereoFrame& frame) {
   FrameResult r;
   auto data = extractor_.extract(next_frame_id_++, frame.timestamp, frame.left, frame.right, &r.extraction);
   r.track = tracker_->track(std::move(data));
-  r.tracking_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  r.tracking_ms = ms_since(t0);
   if (options_.sequential) mapper_->process_pending();
   return r;
 }

@@ -11,9 +11,6 @@
 #include "plslam/matching/stereo_point_frame.h"
 
 namespace plslam::tracking {
-namespace {
-
-}  // namespace
 
 FrameExtractorOptions FrameExtractorOptions::euroc() {
   FrameExtractorOptions o;
