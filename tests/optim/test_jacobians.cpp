@@ -259,6 +259,15 @@ TEST(Jacobians, RelativePoseEdge) {
   std::printf("relative pose edge: worst relative error %.2e over %d configs\n", worst, kConfigs);
 }
 
+// The pose-landmark block J_pose' w J_landmark as the structured form gives it: with BR = B R,
+// the translation rows are BR and the rotation rows are Xc x (each column of BR).
+Eigen::Matrix<double, 6, 3> pose_landmark_block(const Eigen::Matrix3d& BR, const Eigen::Vector3d& Xc) {
+  Eigen::Matrix<double, 6, 3> W;
+  W.topRows<3>() = BR;
+  for (int j = 0; j < 3; ++j) W.block<3, 1>(3, j) = Xc.cross(BR.col(j));
+  return W;
+}
+
 // The structured normal equations the optimisers accumulate (stereo_point_weighted_normal and
 // add_pose_normal_equations) against the products of the explicit Jacobians.
 TEST(Jacobians, StereoPointNormalEquationsFromStructure) {
@@ -289,9 +298,7 @@ TEST(Jacobians, StereoPointNormalEquationsFromStructure) {
     const Eigen::Matrix3d Hx_ref = w * Jx.transpose() * Jx;
     const Eigen::Matrix<double, 6, 3> W_ref = w * Jp.transpose() * Jx;
     const Eigen::Matrix3d BR = B * T.rotation();
-    Eigen::Matrix<double, 6, 3> W;
-    W.topRows<3>() = BR;
-    for (int j = 0; j < 3; ++j) W.block<3, 1>(3, j) = Xc.cross(BR.col(j));
+    const Eigen::Matrix<double, 6, 3> W = pose_landmark_block(BR, Xc);
     ASSERT_LT((H - H_ref).norm(), 1e-12 * H_ref.norm()) << i;
     ASSERT_LT((g - g_ref).norm(), 1e-12 * std::max(g_ref.norm(), 1e-300)) << i;
     ASSERT_LT((T.rotation().transpose() * BR - Hx_ref).norm(), 1e-12 * Hx_ref.norm()) << i;
@@ -335,9 +342,7 @@ TEST(Jacobians, StereoLineNormalEquationsFromStructure) {
       const Eigen::Matrix3d Hx_ref = J[x]->transpose() * wr.asDiagonal() * *J[x];
       const Eigen::Matrix<double, 6, 3> W_ref = Jp.transpose() * wr.asDiagonal() * *J[x];
       const Eigen::Matrix3d BR = B[x] * T.rotation();
-      Eigen::Matrix<double, 6, 3> W;
-      W.topRows<3>() = BR;
-      for (int j = 0; j < 3; ++j) W.block<3, 1>(3, j) = Xc[x]->cross(BR.col(j));
+      const Eigen::Matrix<double, 6, 3> W = pose_landmark_block(BR, *Xc[x]);
       ASSERT_LT((T.rotation().transpose() * BR - Hx_ref).norm(), 1e-12 * Hx_ref.norm()) << i;
       ASSERT_LT((T.rotation().transpose() * a[x] - J[x]->transpose() * wr.asDiagonal() * r).norm(),
                 1e-12 * std::max(g_ref.norm(), 1e-300)) << i;
