@@ -1,3 +1,4 @@
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -15,22 +16,46 @@ TEST(PidController, MatchesHandComputedSequence) {
   // 2: P=-10, I=-3 (sum -30), D=0.2*(-10)=-2         -> -15
   // 3: P=-10, I=-5 (sum -50), D=0                    -> -15
   // 4: P=0,  I=-5 (sum -50),  D=0.2*(20)=4           -> -1
-  EXPECT_DOUBLE_EQ(pid.update(-10), -6.0);
-  EXPECT_DOUBLE_EQ(pid.update(-20), -15.0);
-  EXPECT_DOUBLE_EQ(pid.update(-20), -15.0);
-  EXPECT_DOUBLE_EQ(pid.update(0), -1.0);
+  EXPECT_DOUBLE_EQ(pid.update(-10, 1.0), -6.0);
+  EXPECT_DOUBLE_EQ(pid.update(-20, 1.0), -15.0);
+  EXPECT_DOUBLE_EQ(pid.update(-20, 1.0), -15.0);
+  EXPECT_DOUBLE_EQ(pid.update(0, 1.0), -1.0);
   pid.reset();
   EXPECT_DOUBLE_EQ(pid.integral(), 0.0);
-  EXPECT_DOUBLE_EQ(pid.update(-10), -6.0);  // no derivative kick after a reset
+  EXPECT_DOUBLE_EQ(pid.update(-10, 1.0), -6.0);  // no derivative kick after a reset
+}
+
+TEST(PidController, WorksOnSecondsSoADroppedSampleChangesNothing) {
+  // Error ramp e(t) = -100 t, sampled every 0.1 s, or with the sample at 0.2 s dropped.
+  PidController every({0.2, 0.1, 0.005}, 1e9, 1e9), dropped({0.2, 0.1, 0.005}, 1e9, 1e9);
+  double out_every = 0, out_dropped = 0;
+  for (int k = 1; k <= 4; ++k) out_every = every.update(-10.0 * k, 0.1);
+  out_dropped = dropped.update(-10.0, 0.1);
+  out_dropped = dropped.update(-30.0, 0.2);
+  out_dropped = dropped.update(-40.0, 0.1);
+  // Rectangle rule: the integral over a gap takes the error at its end. Every: -(10+20+30+40)·0.1;
+  // dropped: -(10·0.1 + 30·0.2 + 40·0.1); the derivative (-100/s) and P term agree exactly.
+  EXPECT_NEAR(every.integral(), -10.0, 1e-12);
+  EXPECT_NEAR(dropped.integral(), -11.0, 1e-12);
+  EXPECT_NEAR(out_every, 0.2 * -40 + 0.1 * -10.0 + 0.005 * -100, 1e-12);
+  EXPECT_NEAR(out_dropped, 0.2 * -40 + 0.1 * -11.0 + 0.005 * -100, 1e-12);
+  EXPECT_NEAR(out_dropped, out_every, 0.1 * std::abs(out_every));
+}
+
+TEST(PidController, NoTimeNoIntegralNoDerivative) {
+  PidController pid({1.0, 1.0, 1.0}, 100.0, 100.0);
+  EXPECT_DOUBLE_EQ(pid.update(-10, 0.0), -10.0);  // first sample: P only
+  EXPECT_DOUBLE_EQ(pid.update(-20, -0.1), -20.0);  // time going back: P only
+  EXPECT_DOUBLE_EQ(pid.integral(), 0.0);
 }
 
 TEST(PidController, ClampsIntegralAndOutput) {
   PidController pid({1.0, 1.0, 0.0}, 25.0, 30.0);
-  for (int i = 0; i < 10; ++i) pid.update(-10);
+  for (int i = 0; i < 10; ++i) pid.update(-10, 1.0);
   EXPECT_DOUBLE_EQ(pid.integral(), -25.0);       // anti-windup
-  EXPECT_DOUBLE_EQ(pid.update(-10), -30.0);      // -10 - 25 = -35, clamped
+  EXPECT_DOUBLE_EQ(pid.update(-10, 1.0), -30.0);      // -10 - 25 = -35, clamped
   // integral -25 + 40 = 15; P 40 + I 15 = 55, clamped to +30.
-  EXPECT_DOUBLE_EQ(pid.update(+40), 30.0);
+  EXPECT_DOUBLE_EQ(pid.update(+40, 1.0), 30.0);
 }
 
 TEST(VelocityKalmanFilter, ConvergesToConstantSpeed) {

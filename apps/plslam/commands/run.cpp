@@ -18,6 +18,7 @@
 #include "plslam/io/frame_stream.h"
 #include "plslam/io/map_export.h"
 #include "plslam/io/trajectory_io.h"
+#include "plslam/system/input_aligned_trajectory.h"
 #include "plslam/system/run_report.h"
 #include "plslam/system/slam_system.h"
 #include "plslam/system/system_config.h"
@@ -26,6 +27,9 @@ namespace plslam::cli {
 namespace {
 
 namespace fs = std::filesystem;
+
+// Exit code of a run in which tracking never started a map (README: exit codes).
+constexpr int kExitNotInitialized = 3;
 
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_sigint(int) { g_interrupted = true; }
@@ -59,12 +63,18 @@ int run_slam(const RunArgs& args) {
   std::string fatal;
   const auto start = std::chrono::steady_clock::now();
   auto last_progress = start;
+  report.input_frames = ds->size();
+  std::size_t reached = 0;  // input frames before the one the run stopped at
+  io::FrameStream stream(*ds);
   try {
-    io::FrameStream stream(*ds);
     std::size_t done = 0;
     while (!g_interrupted) {
       auto frame = stream.next();
-      if (!frame) break;
+      if (!frame) {
+        reached = ds->size();
+        report.complete = true;
+        break;
+      }
       if (args.realtime && done > 0) {
         // Pace the input at the dataset's rate, as a live camera would deliver it.
         const double t_rel = frame->timestamp - ds->timestamps().front();
@@ -72,6 +82,7 @@ int run_slam(const RunArgs& args) {
       }
       const auto r = slam.process(*frame);
       report.add(r);
+      reached = frame->index + 1;
       ++done;
       const auto now = std::chrono::steady_clock::now();
       if (!args.quiet && (now - last_progress > std::chrono::seconds(1) || done == ds->size())) {
@@ -82,17 +93,37 @@ int run_slam(const RunArgs& args) {
                      slam.map().num_lines());
       }
     }
-    report.skipped_frames = stream.skipped();
   } catch (const InputError& e) {
     fatal = e.what();  // outputs so far are still written below
+  }
+  for (auto& s : stream.skipped_frames()) {
+    // Frames skipped before the stopping point belong to this run; the reader may have run ahead.
+    if (s.index < reached) report.skipped.push_back(std::move(s));
   }
   if (g_interrupted) spdlog::warn("interrupted: writing the outputs gathered so far");
   slam.finish();
 
-  const auto traj = slam.trajectory();
+  if (!slam.initialized_at()) {
+    // No pose was ever tracked: an identity trajectory would look perfect to an evaluator, so
+    // none is written; stats.json says what happened.
+    std::ofstream(out_dir / "stats.json") << report.to_json(slam).dump(2) << "\n";
+    if (!fatal.empty()) throw InputError("", fatal);
+    if (g_interrupted) return 130;
+    std::cerr << fmt::format(
+        "plslam: error: {}: tracking never initialised in {} frames (no frame had {} stereo points); "
+        "no trajectory written\n",
+        ds->root().string(), report.frames, options.tracker.init_min_points);
+    return kExitNotInitialized;
+  }
+
+  const auto traj = slam.tracked_trajectory();
   io::write_trajectory(out_dir / "trajectory.tum", traj, io::TrajectoryFormat::kTum);
+  const std::vector<double> reached_times(ds->timestamps().begin(),
+                                          ds->timestamps().begin() + static_cast<std::ptrdiff_t>(reached));
+  const auto aligned = system::align_to_input(slam.tracker().records(), reached_times);
+  report.untracked_lines = aligned.untracked;
   if (ds->format() == io::DatasetFormat::kKitti) {
-    io::write_trajectory(out_dir / "trajectory.kitti", traj, io::TrajectoryFormat::kKitti);
+    io::write_trajectory(out_dir / "trajectory.kitti", aligned.poses, io::TrajectoryFormat::kKitti);
   }
   io::write_trajectory(out_dir / "keyframes.tum", slam.keyframe_trajectory(), io::TrajectoryFormat::kTum);
   std::vector<Eigen::Vector3d> points;
@@ -104,6 +135,7 @@ int run_slam(const RunArgs& args) {
 
   auto stats = report.to_json(slam);
   if (ds->ground_truth()) {
+    // Tracked poses only: a prediction made while lost is not an estimate to score.
     const auto accuracy = system::evaluate_against_ground_truth(*ds, traj);
     stats["accuracy"] = accuracy;
     std::cout << system::format_accuracy(accuracy);

@@ -1,10 +1,23 @@
 #include "plslam/io/frame_stream.h"
 
+#include <fmt/format.h>
+#include <opencv2/core.hpp>
 #include <spdlog/spdlog.h>
 
 #include "plslam/core/error.h"
 
 namespace plslam::io {
+namespace {
+
+// A uniform image (a dead sensor, a zero-filled file) decodes fine but carries no features:
+// tracking it would declare the camera lost. Such a frame is skipped like an unreadable one.
+void reject_blank(const cv::Mat& image, const std::filesystem::path& path) {
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(image, &lo, &hi);
+  if (lo == hi) throw InputError(path.string(), fmt::format("blank image (every pixel is {})", lo));
+}
+
+}  // namespace
 
 FrameStream::FrameStream(const Dataset& dataset, std::size_t capacity)
     : dataset_(dataset), capacity_(capacity == 0 ? 1 : capacity), worker_([this] { run(); }) {}
@@ -27,16 +40,21 @@ void FrameStream::run() {
         if (stop_) break;
       }
       std::optional<StereoFrame> frame;
+      std::string reason;
       try {
         frame = dataset_.load(i);
+        reject_blank(frame->left, frame->left_path);
+        reject_blank(frame->right, frame->right_path);
       } catch (const InputError& e) {
-        spdlog::error("skipping frame {}: {}", i, e.what());
+        frame.reset();
+        reason = e.what();
+        spdlog::warn("skipping frame {}: {}", i, reason);
       }
       std::lock_guard lock(mutex_);
       if (frame) {
         queue_.push_back(std::move(*frame));
       } else {
-        ++skipped_;
+        skipped_.push_back({i, dataset_.timestamps()[i], std::move(reason)});
       }
       cv_.notify_all();
     }
@@ -63,6 +81,11 @@ std::optional<StereoFrame> FrameStream::next() {
 }
 
 std::size_t FrameStream::skipped() const {
+  std::lock_guard lock(mutex_);
+  return skipped_.size();
+}
+
+std::vector<SkippedFrame> FrameStream::skipped_frames() const {
   std::lock_guard lock(mutex_);
   return skipped_;
 }

@@ -8,11 +8,21 @@
 #include <exception>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "plslam/io/dataset.h"
 
 namespace plslam::io {
+
+// A frame left out because its images could not be read; `index` is its place in the dataset
+// (within the selected range), so the frames after it keep theirs.
+struct SkippedFrame {
+  std::size_t index = 0;
+  double timestamp = 0;
+  std::string reason;
+};
 
 class FrameStream {
  public:
@@ -26,6 +36,8 @@ class FrameStream {
   std::optional<StereoFrame> next();
 
   std::size_t skipped() const;
+  // Every frame skipped so far, in order, with the reason.
+  std::vector<SkippedFrame> skipped_frames() const;
   std::size_t capacity() const { return capacity_; }
   // Frames decoded but not yet taken (never more than capacity()).
   std::size_t queued() const;
@@ -38,7 +50,7 @@ class FrameStream {
   mutable std::mutex mutex_;
   std::condition_variable cv_;
   std::deque<StereoFrame> queue_;
-  std::size_t skipped_ = 0;
+  std::vector<SkippedFrame> skipped_;
   bool done_ = false;
   bool stop_ = false;
   std::exception_ptr error_;

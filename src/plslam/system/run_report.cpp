@@ -12,7 +12,7 @@
 namespace plslam::system {
 void RunReport::add(const FrameResult& r) {
   ++frames;
-  if (r.track.state == tracking::TrackingState::kOk) ++tracked_frames;
+  if (r.track.tracked) ++tracked_frames;
   tracking_ms.push_back(r.tracking_ms);
   extraction_ms.push_back(r.extraction.extraction_ms);
   stereo_ms.push_back(r.extraction.stereo_ms);
@@ -23,9 +23,33 @@ void RunReport::add(const FrameResult& r) {
 
 nlohmann::json RunReport::to_json(const System& slam) const {
   const auto ms = slam.mapper_stats();
-  return {{"frames", frames},
+  const auto init = slam.initialized_at();
+  std::vector<long> lost_ids;
+  std::size_t before_init = 0;
+  for (const auto& rec : slam.tracker().records()) {
+    if (rec.tracked) continue;
+    if (init && rec.frame_id > *init) {
+      lost_ids.push_back(rec.frame_id);
+    } else {
+      ++before_init;
+    }
+  }
+  auto skipped_json = nlohmann::json::array();
+  for (const auto& s : skipped) {
+    skipped_json.push_back({{"frame", s.index}, {"timestamp", s.timestamp}, {"reason", s.reason}});
+  }
+  return {{"complete", complete},
+          {"input_frames", input_frames},
+          {"frames", frames},
+          {"initialized_at_frame", init ? nlohmann::json(*init) : nlohmann::json(nullptr)},
           {"tracked_frames", tracked_frames},
-          {"skipped_frames", skipped_frames},
+          {"frames_before_initialization", before_init},
+          {"lost_frames", lost_ids.size()},
+          {"lost_frame_ids", lost_ids},
+          {"relocalized_frames", 0},  // no relocalisation yet: a lost camera starts a new map segment
+          {"skipped_frames", skipped.size()},
+          {"skipped", skipped_json},
+          {"untracked_kitti_lines", untracked_lines},
           {"lost_events", slam.tracker().lost_events()},
           {"keyframes", slam.map().num_keyframes()},
           {"map_points", slam.map().num_points()},
@@ -48,9 +72,9 @@ nlohmann::json RunReport::to_json(const System& slam) const {
 
 std::string RunReport::summary(const System& slam) const {
   return fmt::format(
-      "frames {} (tracked {}), lost events {}, keyframes {}, map points {}, map lines {}\n"
+      "frames {} (tracked {}, skipped {}), lost events {}, keyframes {}, map points {}, map lines {}\n"
       "tracking ms/frame: median {:.1f}, mean {:.1f}, p90 {:.1f}\n",
-      frames, tracked_frames, slam.tracker().lost_events(), slam.map().num_keyframes(), slam.map().num_points(),
+      frames, tracked_frames, skipped.size(), slam.tracker().lost_events(), slam.map().num_keyframes(), slam.map().num_points(),
       slam.map().num_lines(), percentile(tracking_ms, 0.5), mean(tracking_ms), percentile(tracking_ms, 0.9));
 }
 

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "plslam/io/dataset.h"
+#include "plslam/io/frame_stream.h"
 #include "plslam/system/slam_system.h"
 
 namespace plslam::system {
@@ -14,9 +15,15 @@ namespace plslam::system {
 struct RunReport {
   std::vector<double> tracking_ms, extraction_ms, stereo_ms, track_motion_ms, track_local_map_ms,
       pose_optimization_ms;
-  std::size_t frames = 0, tracked_frames = 0, skipped_frames = 0;
+  std::size_t frames = 0, tracked_frames = 0;
+  std::size_t input_frames = 0;            // frames the input holds (the selected range)
+  std::vector<io::SkippedFrame> skipped;   // unreadable or blank frames, left out
+  std::vector<std::size_t> untracked_lines;  // input frames whose trajectory.kitti line is not tracked
+  bool complete = false;                   // every input frame was reached
 
   void add(const FrameResult& r);
+  // Counts and ids of the frames tracked, lost, before initialisation and skipped (from the
+  // tracker's records), timings, and the map's size.
   nlohmann::json to_json(const System& slam) const;
   std::string summary(const System& slam) const;
 };

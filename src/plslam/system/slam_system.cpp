@@ -50,7 +50,9 @@ System::~System() { finish(); }
 FrameResult System::process(const io::StereoFrame& frame) {
   const auto t0 = std::chrono::steady_clock::now();
   FrameResult r;
-  auto data = extractor_.extract(next_frame_id_++, frame.timestamp, frame.left, frame.right, &r.extraction);
+  // The id is the frame's place in the input, so skipped frames leave gaps instead of shifting
+  // every later frame (the keyframe policy counts frames by id, the outputs align by it).
+  auto data = extractor_.extract(static_cast<long>(frame.index), frame.timestamp, frame.left, frame.right, &r.extraction);
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
   if (options_.sequential) mapper_->process_pending();
@@ -64,12 +66,19 @@ void System::finish() {
   mapper_->stop();
 }
 
-Trajectory System::trajectory() const {
+Trajectory System::tracked_trajectory() const {
   Trajectory out;
   for (const auto& rec : tracker_->records()) {
-    out.push_back({rec.timestamp, tracking::Tracker::pose_of(rec).inverse().isometry()});
+    if (rec.tracked) out.push_back({rec.timestamp, tracking::Tracker::pose_of(rec).inverse().isometry()});
   }
   return out;
+}
+
+std::optional<long> System::initialized_at() const {
+  for (const auto& rec : tracker_->records()) {
+    if (rec.tracked) return rec.frame_id;
+  }
+  return std::nullopt;
 }
 
 Trajectory System::keyframe_trajectory() const {

@@ -3,6 +3,7 @@
 // The caller's thread is the tracking thread; local mapping runs concurrently (or, with
 // `sequential`, in the tracking thread after each keyframe, for reproducible runs).
 #include <memory>
+#include <optional>
 
 #include "plslam/core/types.h"
 #include "plslam/io/dataset.h"
@@ -42,8 +43,11 @@ class System {
   // Lets local mapping finish its queue and stops it. Outputs are final after this.
   void finish();
 
-  // Every processed frame, T_world_leftcam with world = the first keyframe's camera.
-  Trajectory trajectory() const;
+  // The tracked frames only (never a prediction made while lost or before initialisation),
+  // T_world_leftcam with world = the first keyframe's camera.
+  Trajectory tracked_trajectory() const;
+  // The id of the first frame that started a map; nullopt while none has.
+  std::optional<long> initialized_at() const;
   Trajectory keyframe_trajectory() const;
   const map::Map& map() const { return map_; }
   const tracking::Tracker& tracker() const { return *tracker_; }
@@ -55,7 +59,6 @@ class System {
   tracking::FrameExtractor extractor_;
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
-  long next_frame_id_ = 0;
   bool finished_ = false;
 };
 

@@ -44,12 +44,12 @@ KeyframePolicy::KeyframePolicy(KeyframePolicyOptions options)
 KeyframeDecision KeyframePolicy::decide(const KeyframeInputs& in) {
   KeyframeDecision d;
 
+  const double dt = has_last_timestamp_ ? in.timestamp - last_timestamp_ : 0.0;
   if (options_.kalman) {
     if (!reference_position_) {
       reference_position_ = in.position;
       kalman_.reset_reference();
     }
-    const double dt = has_last_timestamp_ ? in.timestamp - last_timestamp_ : 0.0;
     kalman_.update(dt, in.position - *reference_position_);
     d.speed = kalman_.speed();
   }
@@ -60,7 +60,7 @@ KeyframeDecision KeyframePolicy::decide(const KeyframeInputs& in) {
   const double cur = static_cast<double>(in.tracked_inliers);
   if (options_.pid) {
     const double limit = options_.pid_output_limit * ref;
-    d.delta_pid = std::clamp(pid_.update(cur - ref), -limit, limit);
+    d.delta_pid = std::clamp(pid_.update(cur - ref, dt), -limit, limit);
   }
   const double ratio = in.keyframes_in_map < 2 ? 0.4 : options_.ratio;
   d.threshold = (ref + d.delta_pid) * ratio;

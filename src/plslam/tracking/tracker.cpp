@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "plslam/geometry/stereo_camera.h"
+#include "plslam/tracking/motion_model.h"
 
 namespace plslam::tracking {
 namespace {
@@ -39,6 +40,12 @@ double Tracker::close_depth(const Frame& f) const {
   return options_.close_depth_baselines * f.data->calib.baseline;
 }
 
+geometry::SE3 Tracker::predicted_pose(const Frame& f) const {
+  if (!last_) return f.T_cw;
+  if (!velocity_) return last_->T_cw;
+  return predict_pose(*velocity_, velocity_dt_, f.data->timestamp - last_->data->timestamp, last_->T_cw);
+}
+
 geometry::SE3 Tracker::pose_of(const FrameRecord& r) {
   geometry::SE3 T_cr = r.T_cr;
   map::KeyFrame* ref = r.reference;
@@ -62,7 +69,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     if (state_ == TrackingState::kLost && last_) {
       // A new map segment starts where the motion model puts the camera, so the trajectory stays
       // continuous across the loss.
-      f.T_cw = velocity_ ? (*velocity_ * last_->T_cw).normalized() : last_->T_cw;
+      f.T_cw = predicted_pose(f);
     }
     ok = initialize(f);
     if (ok) {
@@ -79,6 +86,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     if (tracked) {
       ok = true;
       velocity_ = (f.T_cw * last_->T_cw.inverse()).normalized();
+      velocity_dt_ = f.data->timestamp - last_->data->timestamp;
       const auto inputs = keyframe_inputs(f, result.point_inliers, result.line_inliers);
       result.decision = policy_.decide(inputs);
       if (result.decision.insert) {
@@ -91,8 +99,9 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       ++lost_events_;
       spdlog::warn("frame {}: tracking lost (event {}), starting a new map segment", f.id(), lost_events_);
       state_ = TrackingState::kLost;
-      // Keep a pose for the trajectory: the motion model's prediction.
-      f.T_cw = velocity_ && last_ ? (*velocity_ * last_->T_cw).normalized() : (last_ ? last_->T_cw : f.T_cw);
+      // The motion model's prediction: where a new map segment will start. It is not a tracked
+      // pose (the record says so), and the trajectory outputs never present it as one.
+      f.T_cw = predicted_pose(f);
       std::fill(f.points.begin(), f.points.end(), nullptr);
       std::fill(f.lines.begin(), f.lines.end(), nullptr);
     }
@@ -106,10 +115,8 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   rec.T_cr = f.reference ? f.T_cw * f.reference->pose_inverse() : f.T_cw;
   rec.tracked = ok;
   records_.push_back(rec);
-  if (!ok && state_ == TrackingState::kNotInitialized) {
-    // Not enough stereo points yet: nothing to track against, keep waiting.
-  }
   result.state = state_;
+  result.tracked = ok;
   last_ = std::move(f);
   return result;
 }
@@ -187,7 +194,7 @@ int Tracker::optimize_pose(Frame& f, TrackStageTimes& t) {
 
 bool Tracker::track_with_motion_model(Frame& f, TrackStageTimes& t) {
   const auto t0 = Clock::now();
-  const geometry::SE3 predicted = (*velocity_ * last_->T_cw).normalized();
+  const geometry::SE3 predicted = predicted_pose(f);
   std::vector<map::MapLine*> last_lines;
   if (options_.lines) {
     for (std::size_t j = 0; j < last_->lines.size(); ++j) {

@@ -53,6 +53,7 @@ struct TrackStageTimes {
 
 struct TrackResult {
   TrackingState state = TrackingState::kNotInitialized;
+  bool tracked = false;  // the frame has a tracked pose (initialised a map or was tracked in one)
   int point_inliers = 0;
   int line_inliers = 0;
   bool keyframe = false;
@@ -99,6 +100,8 @@ class Tracker {
   void create_stereo_line(Frame& f, map::KeyFrame* kf, std::size_t j);
   KeyframeInputs keyframe_inputs(const Frame& f, int point_inliers, int line_inliers) const;
   double close_depth(const Frame& f) const;
+  // Where the constant-velocity model puts `f`, from the last frame and the time between them.
+  geometry::SE3 predicted_pose(const Frame& f) const;
 
   map::Map& map_;
   TrackerOptions options_;
@@ -109,6 +112,7 @@ class Tracker {
   TrackingState state_ = TrackingState::kNotInitialized;
   std::optional<Frame> last_;
   std::optional<geometry::SE3> velocity_;  // T_cur_last of the previous step
+  double velocity_dt_ = 0;                  // seconds that step spanned
   map::KeyFrame* reference_ = nullptr;
   map::KeyFrame* last_keyframe_ = nullptr;
   std::vector<map::KeyFrame*> local_keyframes_;
