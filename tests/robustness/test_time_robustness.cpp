@@ -1,0 +1,213 @@
+// Robustness of `plslam run` to time gaps and damaged frames (issue 20, classes 1, 2 and 5), on
+// short rearranged copies of the KITTI 06 excerpt: dropped frames, unreadable and blank images,
+// a sequence that never initialises, a frame that loses tracking. Each case asserts the exit
+// code, the message or stats.json fields, and the alignment of the trajectory files.
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "plslam/io/trajectory_io.h"
+#include "support/test_support.h"
+
+namespace plslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+enum class Damage { kNone, kEmptyFile, kBlank };
+
+// A KITTI layout under `root` whose frame i shows source frame `frames[i]` of the shared 06
+// excerpt (images, time and ground-truth pose), with `damage` applied to some left images.
+fs::path make_copy(const fs::path& data, const fs::path& root, const std::vector<int>& frames,
+                   const std::map<std::size_t, Damage>& damage = {}) {
+  const fs::path src = data / "kitti" / "sequences" / "06";
+  const fs::path seq = root / "sequences" / "06";
+  fs::create_directories(seq / "image_0");
+  fs::create_directories(seq / "image_1");
+  fs::create_directories(root / "poses");
+  fs::create_symlink(src / "calib.txt", seq / "calib.txt");
+  std::vector<std::string> times, poses;
+  {
+    std::ifstream t(src / "times.txt"), p(data / "kitti" / "poses" / "06.txt");
+    for (std::string l; std::getline(t, l);) times.push_back(l);
+    for (std::string l; std::getline(p, l);) poses.push_back(l);
+  }
+  std::ofstream times_out(seq / "times.txt"), poses_out(root / "poses" / "06.txt");
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const std::string src_name = fmt::format("{:06d}.png", frames[i]);
+    const std::string name = fmt::format("{:06d}.png", i);
+    const auto it = damage.find(i);
+    const Damage d = it == damage.end() ? Damage::kNone : it->second;
+    if (d == Damage::kEmptyFile) {
+      std::ofstream(seq / "image_0" / name);
+    } else if (d == Damage::kBlank) {
+      const cv::Mat img = cv::imread((src / "image_0" / src_name).string(), cv::IMREAD_GRAYSCALE);
+      cv::imwrite((seq / "image_0" / name).string(), cv::Mat(img.size(), CV_8U, cv::Scalar(128)));
+    } else {
+      fs::create_symlink(src / "image_0" / src_name, seq / "image_0" / name);
+    }
+    fs::create_symlink(src / "image_1" / src_name, seq / "image_1" / name);
+    times_out << times.at(static_cast<std::size_t>(frames[i])) << "\n";
+    poses_out << poses.at(static_cast<std::size_t>(frames[i])) << "\n";
+  }
+  return seq;
+}
+
+std::vector<int> range(int from, int to, int step = 1) {
+  std::vector<int> v;
+  for (int i = from; i < to; i += step) v.push_back(i);
+  return v;
+}
+
+struct Run {
+  test::CliResult cli;
+  fs::path out;
+  nlohmann::json stats;
+};
+
+Run run(const fs::path& seq, const fs::path& out) {
+  Run r;
+  r.out = out;
+  r.cli = test::run_cli("run \"" + seq.string() + "\" --out \"" + out.string() + "\" --quiet --sequential");
+  if (fs::exists(out / "stats.json")) {
+    std::ifstream in(out / "stats.json");
+    r.stats = nlohmann::json::parse(in);
+  }
+  return r;
+}
+
+// Every input frame tracked: one TUM pose per frame and one KITTI line per input frame.
+void expect_all_tracked(const Run& r, std::size_t frames) {
+  ASSERT_EQ(r.cli.exit_code, 0) << r.cli.err;
+  EXPECT_EQ(r.stats["tracked_frames"], frames);
+  EXPECT_EQ(r.stats["lost_frames"], 0);
+  EXPECT_EQ(r.stats["lost_events"], 0);
+  EXPECT_EQ(r.stats["complete"], true);
+  EXPECT_EQ(r.stats["initialized_at_frame"], 0);
+  EXPECT_EQ(io::read_trajectory(r.out / "trajectory.tum", io::TrajectoryFormat::kTum).size(), frames);
+  EXPECT_EQ(io::read_trajectory(r.out / "trajectory.kitti", io::TrajectoryFormat::kKitti).size(), frames);
+}
+
+double ate(const Run& r) { return r.stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(); }
+
+TEST(TimeRobustness, SingleDroppedFrameKeepsTracking) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  auto frames = range(0, 16);
+  frames.erase(frames.begin() + 8);
+  const auto r = run(make_copy(data, tmp.path() / "d", frames), tmp.path() / "out");
+  expect_all_tracked(r, 15);
+  EXPECT_LT(ate(r), 0.1);
+}
+
+TEST(TimeRobustness, EverySecondFrameDroppedKeepsTracking) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto r = run(make_copy(data, tmp.path() / "d", range(0, 30, 2)), tmp.path() / "out");
+  expect_all_tracked(r, 15);
+  EXPECT_LT(ate(r), 0.1);
+}
+
+TEST(TimeRobustness, FramesDroppedAtTheStartAndTheEnd) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  // Source frames 1, 2 (frame 0 missing), then 3 is missing; 4..12, then 13 missing before 14.
+  const std::vector<int> frames = {1, 2, 4, 5, 6, 7, 8, 9, 10, 11, 12, 14};
+  const auto r = run(make_copy(data, tmp.path() / "d", frames), tmp.path() / "out");
+  expect_all_tracked(r, frames.size());
+  EXPECT_LT(ate(r), 0.1);
+}
+
+// A damaged left image at input frame 6 of 14: skipped with its reason, the frames after it keep
+// their index, and the KITTI line of frame 6 is listed as not tracked.
+void expect_skipped_mid_sequence(Damage damage, const std::string& reason_part) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto seq = make_copy(data, tmp.path() / "d", range(0, 14), {{6, damage}});
+  const auto r = run(seq, tmp.path() / "out");
+  ASSERT_EQ(r.cli.exit_code, 0) << r.cli.err;
+  EXPECT_NE(r.cli.err.find("skipping frame 6"), std::string::npos) << r.cli.err;
+  EXPECT_EQ(r.stats["skipped_frames"], 1);
+  ASSERT_EQ(r.stats["skipped"].size(), 1u);
+  EXPECT_EQ(r.stats["skipped"][0]["frame"], 6);
+  const auto reason = r.stats["skipped"][0]["reason"].get<std::string>();
+  EXPECT_NE(reason.find("000006.png"), std::string::npos) << reason;
+  EXPECT_NE(reason.find(reason_part), std::string::npos) << reason;
+  EXPECT_EQ(r.stats["tracked_frames"], 13);
+  EXPECT_EQ(r.stats["lost_events"], 0);
+  EXPECT_EQ(r.stats["untracked_kitti_lines"], nlohmann::json::array({6}));
+  const auto tum = io::read_trajectory(r.out / "trajectory.tum", io::TrajectoryFormat::kTum);
+  const auto kitti = io::read_trajectory(r.out / "trajectory.kitti", io::TrajectoryFormat::kKitti);
+  ASSERT_EQ(tum.size(), 13u);
+  ASSERT_EQ(kitti.size(), 14u);
+  // Index alignment: KITTI line i is the tracked pose of input frame i (TUM pose k for frame
+  // k < 6, k + 1 after the gap); line 6 holds frame 5's pose.
+  for (std::size_t i = 0; i < 14; ++i) {
+    const std::size_t k = i < 6 ? i : (i == 6 ? 5 : i - 1);
+    EXPECT_TRUE(kitti[i].T.matrix().isApprox(tum[k].T.matrix(), 1e-9)) << "line " << i;
+  }
+  EXPECT_LT(ate(r), 0.1);
+}
+
+TEST(TimeRobustness, ZeroByteImageMidSequenceIsSkippedAndKeepsAlignment) {
+  expect_skipped_mid_sequence(Damage::kEmptyFile, "");
+}
+
+TEST(TimeRobustness, BlankImageMidSequenceIsSkippedAndKeepsAlignment) {
+  expect_skipped_mid_sequence(Damage::kBlank, "blank image");
+}
+
+TEST(TimeRobustness, NeverInitialisingRunFailsWithoutATrajectory) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  std::map<std::size_t, Damage> all_blank;
+  for (std::size_t i = 0; i < 5; ++i) all_blank[i] = Damage::kBlank;
+  const auto r = run(make_copy(data, tmp.path() / "d", range(0, 5), all_blank), tmp.path() / "out");
+  EXPECT_EQ(r.cli.exit_code, 3);
+  EXPECT_NE(r.cli.err.find("tracking never initialised"), std::string::npos) << r.cli.err;
+  EXPECT_FALSE(fs::exists(r.out / "trajectory.tum"));
+  EXPECT_FALSE(fs::exists(r.out / "trajectory.kitti"));
+  EXPECT_TRUE(r.stats["initialized_at_frame"].is_null());
+  EXPECT_EQ(r.stats["tracked_frames"], 0);
+  EXPECT_EQ(r.stats["skipped_frames"], 5);
+}
+
+TEST(TimeRobustness, LostFrameIsMarkedAndNotInTheTrajectory) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  // Input frame 7 shows source frame 45, 40 m further down the road: it cannot be tracked.
+  auto frames = range(0, 14);
+  frames[7] = 45;
+  const auto seq = make_copy(data, tmp.path() / "d", frames);
+  // Keep frame 7's time in order: its time is that of source frame 7 (times come with the
+  // source frame, so rewrite them as the original sequence's).
+  {
+    std::ifstream t(data / "kitti" / "sequences" / "06" / "times.txt");
+    std::ofstream out(seq / "times.txt");
+    std::string l;
+    for (int i = 0; i < 14 && std::getline(t, l); ++i) out << l << "\n";
+  }
+  const auto r = run(seq, tmp.path() / "out");
+  ASSERT_EQ(r.cli.exit_code, 0) << r.cli.err;
+  const auto lost = r.stats["lost_frame_ids"].get<std::vector<long>>();
+  ASSERT_FALSE(lost.empty());
+  EXPECT_EQ(lost.front(), 7);
+  EXPECT_GE(r.stats["lost_events"].get<int>(), 1);
+  EXPECT_EQ(r.stats["relocalized_frames"], 0);
+  const auto untracked = r.stats["untracked_kitti_lines"].get<std::vector<std::size_t>>();
+  EXPECT_NE(std::find(untracked.begin(), untracked.end(), 7u), untracked.end());
+  const auto tum = io::read_trajectory(r.out / "trajectory.tum", io::TrajectoryFormat::kTum);
+  EXPECT_EQ(tum.size(), 14u - lost.size());
+  EXPECT_EQ(io::read_trajectory(r.out / "trajectory.kitti", io::TrajectoryFormat::kKitti).size(), 14u);
+}
+
+}  // namespace
+}  // namespace plslam
