@@ -209,5 +209,26 @@ TEST(TimeRobustness, LostFrameIsMarkedAndNotInTheTrajectory) {
   EXPECT_EQ(io::read_trajectory(r.out / "trajectory.kitti", io::TrajectoryFormat::kKitti).size(), 14u);
 }
 
+TEST(TimeRobustness, LateStartIsAlignedAndTooShortToScore) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  // Frames 0-2 blank (skipped), the map starts at frame 3: two tracked poses, too few for an ATE.
+  const auto seq = make_copy(data, tmp.path() / "d", range(0, 5),
+                             {{0, Damage::kBlank}, {1, Damage::kBlank}, {2, Damage::kBlank}});
+  const auto r = run(seq, tmp.path() / "out");
+  ASSERT_EQ(r.cli.exit_code, 0) << r.cli.err;
+  EXPECT_EQ(r.stats["initialized_at_frame"], 3);
+  EXPECT_EQ(r.stats["tracked_frames"], 2);
+  EXPECT_EQ(r.stats["skipped_frames"], 3);
+  EXPECT_EQ(r.stats["untracked_kitti_lines"], nlohmann::json::array({0, 1, 2}));
+  EXPECT_TRUE(r.stats["accuracy"].contains("error"));
+  EXPECT_FALSE(r.stats["accuracy"].contains("ape_trans_m"));
+  const auto kitti = io::read_trajectory(r.out / "trajectory.kitti", io::TrajectoryFormat::kKitti);
+  ASSERT_EQ(kitti.size(), 5u);
+  // Lines before the start hold the first tracked pose (the map's origin).
+  EXPECT_TRUE(kitti[0].T.matrix().isApprox(kitti[3].T.matrix(), 1e-12));
+  EXPECT_EQ(io::read_trajectory(r.out / "trajectory.tum", io::TrajectoryFormat::kTum).size(), 2u);
+}
+
 }  // namespace
 }  // namespace plslam

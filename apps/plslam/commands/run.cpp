@@ -136,9 +136,15 @@ int run_slam(const RunArgs& args) {
   auto stats = report.to_json(slam);
   if (ds->ground_truth()) {
     // Tracked poses only: a prediction made while lost is not an estimate to score.
-    const auto accuracy = system::evaluate_against_ground_truth(*ds, traj);
-    stats["accuracy"] = accuracy;
-    std::cout << system::format_accuracy(accuracy);
+    try {
+      const auto accuracy = system::evaluate_against_ground_truth(*ds, traj);
+      stats["accuracy"] = accuracy;
+      std::cout << system::format_accuracy(accuracy);
+    } catch (const InputError& e) {
+      // Too few tracked poses to score (or a degenerate alignment): say so instead of a number.
+      spdlog::warn("no accuracy: {}", e.what());
+      stats["accuracy"] = {{"error", e.what()}};
+    }
   }
   std::ofstream(out_dir / "stats.json") << stats.dump(2) << "\n";
   std::cout << report.summary(slam);
