@@ -24,6 +24,9 @@ struct StereoFrame {
   double timestamp = 0;   // seconds
   cv::Mat left, right;    // 8-bit grey, rectified
   std::filesystem::path left_path, right_path;
+  // Why the frame cannot be used although it decoded (a blank image), empty when it can; the
+  // frame stream skips such frames like unreadable ones.
+  std::string problem;
 };
 
 struct DatasetOptions {

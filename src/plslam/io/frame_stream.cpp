@@ -1,23 +1,10 @@
 #include "plslam/io/frame_stream.h"
 
-#include <fmt/format.h>
-#include <opencv2/core.hpp>
 #include <spdlog/spdlog.h>
 
 #include "plslam/core/error.h"
 
 namespace plslam::io {
-namespace {
-
-// A uniform image (a dead sensor, a zero-filled file) decodes fine but carries no features:
-// tracking it would declare the camera lost. Such a frame is skipped like an unreadable one.
-void reject_blank(const cv::Mat& image, const std::filesystem::path& path) {
-  double lo = 0, hi = 0;
-  cv::minMaxLoc(image, &lo, &hi);
-  if (lo == hi) throw InputError(path.string(), fmt::format("blank image (every pixel is {})", lo));
-}
-
-}  // namespace
 
 FrameStream::FrameStream(const Dataset& dataset, std::size_t capacity)
     : dataset_(dataset), capacity_(capacity == 0 ? 1 : capacity), worker_([this] { run(); }) {}
@@ -43,10 +30,12 @@ void FrameStream::run() {
       std::string reason;
       try {
         frame = dataset_.load(i);
-        reject_blank(frame->left, frame->left_path);
-        reject_blank(frame->right, frame->right_path);
+        if (!frame->problem.empty()) {
+          reason = frame->problem;
+          frame.reset();
+          spdlog::warn("skipping frame {}: {}", i, reason);
+        }
       } catch (const InputError& e) {
-        frame.reset();
         reason = e.what();
         spdlog::warn("skipping frame {}: {}", i, reason);
       }

@@ -4,6 +4,7 @@
 #include <iterator>
 #include <vector>
 
+#include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -30,6 +31,12 @@ cv::Mat load_grey_image(const std::filesystem::path& path) {
     throw InputError(path.string(), "unsupported channel count");
   }
   return img;
+}
+
+std::string blank_image_problem(const cv::Mat& image, const std::filesystem::path& path) {
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(image, &lo, &hi);
+  return lo == hi ? fmt::format("{}: blank image (every pixel is {})", path.string(), lo) : std::string();
 }
 
 }  // namespace plslam::io
