@@ -20,13 +20,11 @@
 #include <memory>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include <Eigen/Cholesky>
-#include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
+#include "plslam/core/worker_pool.h"
 #include "plslam/optim/ba_pass.h"
 #include "plslam/optim/robust.h"
 #include "plslam/optim/schur_kernel.h"
@@ -404,7 +402,7 @@ class SchurLm {
           const BaPassSpec& spec, BaState* s)
       : ctx_{cam, opt, spec.robust}, p_(p), opt_(opt), spec_(spec), s_(s),
         threads_(std::max(1, opt.num_threads)) {
-    if (threads_ > 1) arena_ = std::make_unique<tbb::task_arena>(threads_);
+    if (threads_ > 1) pool_ = std::make_unique<core::WorkerPool>(threads_);
     build(spec.excluded);
   }
 
@@ -417,7 +415,9 @@ class SchurLm {
     return points_.slots() + lines_.slots() + static_cast<int>(points_.fixed.size()) +
            static_cast<int>(lines_.fixed.size());
   }
-  // Runs body(item, acc) over [0, n) with one accumulator per thread and returns their sum.
+  // Runs body(item, acc) over [0, n) and returns the sum of the accumulators. With threads, [0, n)
+  // is cut into one fixed range per thread, each with its own accumulator, summed in range order:
+  // the result depends on the thread count but never on the scheduling.
   template <class Body>
   Accumulator accumulate(int n, const Body& body) const;
 
@@ -450,7 +450,7 @@ class SchurLm {
   BaState* s_;
   int threads_;
   SchurKernelImpl kernel_ = best_schur_kernel();
-  mutable std::unique_ptr<tbb::task_arena> arena_;  // execute() is non-const
+  mutable std::unique_ptr<core::WorkerPool> pool_;  // run() is non-const
 
   std::vector<int> cam_of_kf_;
   std::vector<int> kf_of_cam_;
@@ -485,20 +485,20 @@ void SchurLm::build(const BaExclusions* excluded) {
 template <class Body>
 Accumulator SchurLm::accumulate(int n, const Body& body) const {
   const int n_cams = static_cast<int>(kf_of_cam_.size());
-  if (!arena_) {
+  if (!pool_) {
     Accumulator acc(n_cams, max_group());
     for (int i = 0; i < n; ++i) body(i, acc);
     return acc;
   }
-  tbb::enumerable_thread_specific<Accumulator> local(n_cams, max_group());
-  arena_->execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, n, 64), [&](const tbb::blocked_range<int>& r) {
-      Accumulator& acc = local.local();
-      for (int i = r.begin(); i != r.end(); ++i) body(i, acc);
-    });
+  const int chunks = threads_;
+  std::vector<Accumulator> partial(static_cast<std::size_t>(chunks), Accumulator(n_cams, max_group()));
+  pool_->run(chunks, [&](int c) {
+    Accumulator& acc = partial[static_cast<std::size_t>(c)];
+    const int end = core::chunk_begin(n, chunks, c + 1);
+    for (int i = core::chunk_begin(n, chunks, c); i < end; ++i) body(i, acc);
   });
   Accumulator total(n_cams, 0);
-  for (const Accumulator& acc : local) total.add(acc);
+  for (const Accumulator& acc : partial) total.add(acc);
   return total;
 }
 

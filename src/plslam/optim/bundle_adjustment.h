@@ -71,7 +71,7 @@ struct BaOptions {
   // problem goes to Ceres' SPARSE_SCHUR instead (a large global BA).
   int max_dense_keyframes = 300;
   BaLinearSolver linear_solver = BaLinearSolver::kDenseSchur;
-  int num_threads = 1;  // both backends (kSchurLM: TBB over landmarks)
+  int num_threads = 1;  // both backends (kSchurLM: core::WorkerPool over landmarks, fixed ranges)
 };
 
 struct BaResult {

@@ -1,16 +1,15 @@
 #include "plslam/synth/writer.h"
 
-#include <atomic>
+#include <algorithm>
 #include <fstream>
 #include <mutex>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
 
 #include "plslam/core/error.h"
+#include "plslam/core/worker_pool.h"
 #include "plslam/io/trajectory_io.h"
 
 namespace plslam::synth {
@@ -116,26 +115,26 @@ void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const E
 void render_all(const Sequence& seq, const Progress& progress, int threads,
                 const std::function<void(std::size_t, const StereoImages&)>& sink) {
   const std::size_t n = seq.size();
-  std::atomic<std::size_t> done{0};
+  std::size_t done = 0;
   std::mutex mu;
-  auto body = [&](const tbb::blocked_range<std::size_t>& r) {
+  // Chunks of 8 frames, each with its own renderer (it keeps per-thread scratch images).
+  constexpr std::size_t kChunk = 8;
+  auto body = [&](int c) {
     StereoRenderer renderer(seq);
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+    const std::size_t begin = static_cast<std::size_t>(c) * kChunk, end = std::min(n, begin + kChunk);
+    for (std::size_t i = begin; i < end; ++i) {
       sink(i, renderer.render(i));
-      const std::size_t d = ++done;
-      if (progress) {
-        std::lock_guard<std::mutex> lock(mu);
-        progress(d, n);
-      }
+      std::lock_guard<std::mutex> lock(mu);
+      ++done;
+      if (progress) progress(done, n);
     }
   };
+  const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
   if (threads == 1) {
-    body(tbb::blocked_range<std::size_t>(0, n));
+    for (int c = 0; c < chunks; ++c) body(c);
     return;
   }
-  std::unique_ptr<tbb::global_control> limit;
-  if (threads > 1) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8), body);
+  core::WorkerPool(threads).run(chunks, body);
 }
 
 }  // namespace
