@@ -15,6 +15,7 @@
 #include "command_registry.h"
 #include "commands/dataset_options.h"
 #include "plslam/core/error.h"
+#include "plslam/io/atomic_file.h"
 #include "plslam/io/frame_stream.h"
 #include "plslam/io/map_export.h"
 #include "plslam/io/trajectory_io.h"
@@ -106,7 +107,8 @@ int run_slam(const RunArgs& args) {
   if (!slam.initialized_at()) {
     // No pose was ever tracked: an identity trajectory would look perfect to an evaluator, so
     // none is written; stats.json says what happened.
-    std::ofstream(out_dir / "stats.json") << report.to_json(slam).dump(2) << "\n";
+    const auto stats_text = report.to_json(slam).dump(2);
+    io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats_text << "\n"; });
     if (!fatal.empty()) throw InputError("", fatal);
     if (g_interrupted) return 130;
     std::cerr << fmt::format(
@@ -146,7 +148,7 @@ int run_slam(const RunArgs& args) {
       stats["accuracy"] = {{"error", e.what()}};
     }
   }
-  std::ofstream(out_dir / "stats.json") << stats.dump(2) << "\n";
+  io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats.dump(2) << "\n"; });
   std::cout << report.summary(slam);
   spdlog::info("outputs written to {}", out_dir.string());
   if (!fatal.empty()) throw InputError("", fatal);

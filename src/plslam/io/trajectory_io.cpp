@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "plslam/core/error.h"
+#include "plslam/io/atomic_file.h"
 #include "plslam/io/text_table.h"
 
 namespace plslam::io {
@@ -162,9 +163,7 @@ Trajectory read_trajectory(const std::filesystem::path& path, TrajectoryFormat f
 
 void write_trajectory(const std::filesystem::path& path, const Trajectory& trajectory,
                       TrajectoryFormat format) {
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
-  std::ofstream out(path);
-  if (!out) throw InputError(path.string(), "cannot open for writing");
+  write_file_atomically(path, [&](std::ostream& out) {
   if (format == TrajectoryFormat::kEuroc) {
     out << "#timestamp [ns], p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], "
            "q_RS_y [], q_RS_z []\n";
@@ -193,7 +192,7 @@ void write_trajectory(const std::filesystem::path& path, const Trajectory& traje
       }
     }
   }
-  if (!out) throw InputError(path.string(), "write failed");
+  });
 }
 
 }  // namespace plslam::io
