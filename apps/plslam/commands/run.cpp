@@ -18,6 +18,7 @@
 #include "plslam/io/atomic_file.h"
 #include "plslam/io/frame_stream.h"
 #include "plslam/io/map_export.h"
+#include "plslam/io/output_folder.h"
 #include "plslam/io/trajectory_io.h"
 #include "plslam/system/input_aligned_trajectory.h"
 #include "plslam/system/run_report.h"
@@ -46,13 +47,14 @@ struct RunArgs {
 };
 
 int run_slam(const RunArgs& args) {
+  // Checked before any frame: a bad --out must not be found only when the outputs are written.
+  const fs::path out_dir = args.out;
+  io::prepare_output_folder(out_dir);
   const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
   auto options = system::load_system_options(
       ds->format(), args.config.empty() ? std::nullopt : std::optional<fs::path>(args.config));
   if (args.no_lines) options.disable_lines();
   options.sequential = args.sequential;
-  const fs::path out_dir = args.out;
-  fs::create_directories(out_dir);
 
   spdlog::info("{}: {} frames, {}x{}, {:.1f} fps, baseline {:.3f} m, lines {}", ds->root().string(), ds->size(),
                ds->calibration().width, ds->calibration().height, ds->fps(), ds->calibration().baseline,
