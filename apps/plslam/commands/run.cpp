@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <fstream>
 #include <iostream>
 #include <thread>
@@ -13,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command_registry.h"
+#include "stop_signals.h"
 #include "commands/dataset_options.h"
 #include "plslam/core/error.h"
 #include "plslam/io/atomic_file.h"
@@ -33,8 +33,12 @@ namespace fs = std::filesystem;
 // Exit code of a run in which tracking never started a map (README: exit codes).
 constexpr int kExitNotInitialized = 3;
 
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_sigint(int) { g_interrupted = true; }
+
+// Marks a run stopped by a signal (README: stats.json); "complete" already says it did not finish.
+nlohmann::json with_interruption(nlohmann::json stats) {
+  stats["interrupted_by"] = app::stop_requested() ? nlohmann::json(app::stop_signal_name()) : nlohmann::json(nullptr);
+  return stats;
+}
 
 struct RunArgs {
   DatasetArgs dataset;
@@ -62,7 +66,7 @@ int run_slam(const RunArgs& args) {
 
   system::System slam(ds->calibration(), options);
   system::RunReport report;
-  std::signal(SIGINT, on_sigint);
+  app::install_stop_signals();
   std::string fatal;
   const auto start = std::chrono::steady_clock::now();
   auto last_progress = start;
@@ -71,7 +75,7 @@ int run_slam(const RunArgs& args) {
   io::FrameStream stream(*ds);
   try {
     std::size_t done = 0;
-    while (!g_interrupted) {
+    while (!app::stop_requested()) {
       auto frame = stream.next();
       if (!frame) {
         reached = ds->size();
@@ -103,16 +107,18 @@ int run_slam(const RunArgs& args) {
     // Frames skipped before the stopping point belong to this run; the reader may have run ahead.
     if (s.index < reached) report.skipped.push_back(std::move(s));
   }
-  if (g_interrupted) spdlog::warn("interrupted: writing the outputs gathered so far");
+  if (app::stop_requested()) {
+    spdlog::warn("{}: stopping; writing the outputs of the {} frames processed", app::stop_signal_name(), report.frames);
+  }
   slam.finish();
 
   if (!slam.initialized_at()) {
     // No pose was ever tracked: an identity trajectory would look perfect to an evaluator, so
     // none is written; stats.json says what happened.
-    const auto stats_text = report.to_json(slam).dump(2);
+    const auto stats_text = with_interruption(report.to_json(slam)).dump(2);
     io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats_text << "\n"; });
     if (!fatal.empty()) throw InputError("", fatal);
-    if (g_interrupted) return 130;
+    if (app::stop_requested()) return app::stop_exit_code();
     std::cerr << fmt::format(
         "plslam: error: {}: tracking never initialised in {} frames (no frame had {} stereo points); "
         "no trajectory written\n",
@@ -137,7 +143,7 @@ int run_slam(const RunArgs& args) {
   for (const auto* l : slam.map().lines()) lines.emplace_back(l->start(), l->end());
   io::write_ply_lines(out_dir / "map_lines.ply", lines);
 
-  auto stats = report.to_json(slam);
+  auto stats = with_interruption(report.to_json(slam));
   if (ds->ground_truth()) {
     // Tracked poses only: a prediction made while lost is not an estimate to score.
     try {
@@ -154,7 +160,7 @@ int run_slam(const RunArgs& args) {
   std::cout << report.summary(slam);
   spdlog::info("outputs written to {}", out_dir.string());
   if (!fatal.empty()) throw InputError("", fatal);
-  return g_interrupted ? 130 : 0;
+  return app::stop_requested() ? app::stop_exit_code() : 0;
 }
 
 CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](CLI::App& sub) {
