@@ -39,6 +39,33 @@ TEST(Pnp, EpnpRansacRecoversPoseWithOutliers) {
   }
 }
 
+// The sampler takes its seed from the options: the same seed gives the same pose and inliers
+// bit for bit, another seed still finds the pose.
+TEST(Pnp, SeededSamplerReproduces) {
+  const StereoCamera cam = test::kitti_like_camera();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const SE3 T = test::random_pose(rng, 2.0, 0.5);
+  std::vector<Eigen::Vector3d> world;
+  std::vector<Eigen::Vector2d> pixels;
+  for (int i = 0; i < 150; ++i) {
+    const Eigen::Vector2d uv = test::random_pixel(cam, rng);
+    world.push_back(test::world_point_at(cam, T, uv, test::random_depth(rng)));
+    pixels.push_back(unit(rng) < 0.4 ? test::random_pixel(cam, rng) : uv);
+  }
+  PnpOptions o;
+  o.seed = 7;
+  const PnpResult a = solve_pnp_ransac(cam, world, pixels, o);
+  const PnpResult b = solve_pnp_ransac(cam, world, pixels, o);
+  ASSERT_TRUE(a.success && b.success);
+  EXPECT_EQ(a.inliers, b.inliers);
+  EXPECT_EQ(a.T_cw.matrix(), b.T_cw.matrix());
+  o.seed = 8;
+  const PnpResult c = solve_pnp_ransac(cam, world, pixels, o);
+  ASSERT_TRUE(c.success);
+  EXPECT_LT(test::centre_error(c.T_cw, T), 1e-6);
+}
+
 TEST(Pnp, TooFewOrMismatchedInputs) {
   const StereoCamera cam = test::kitti_like_camera();
   EXPECT_FALSE(solve_pnp_ransac(cam, {{0, 0, 5}, {1, 0, 5}, {0, 1, 5}}, {{1, 1}, {2, 2}, {3, 3}}).success);

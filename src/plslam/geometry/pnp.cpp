@@ -24,11 +24,22 @@ PnpResult solve_pnp_ransac(const StereoCamera& cam, const std::vector<Eigen::Vec
   }
   const cv::Matx33d K(cam.fx(), 0, cam.cx(), 0, cam.fy(), cam.cy(), 0, 0, 1);
   cv::Mat rvec, tvec;
+  cv::UsacParams usac;
+  usac.maxIterations = options.max_iterations;
+  usac.threshold = options.reprojection_error_px;
+  usac.confidence = options.confidence;
+  usac.randomGeneratorState = static_cast<int>(options.seed & 0x7fffffffu);
+  usac.sampler = cv::SAMPLING_UNIFORM;
+  usac.isParallel = false;  // a parallel USAC would not reproduce
+  cv::Mat inlier_mat;
+  bool ok = false;
+  try {
+    ok = cv::solvePnPRansac(obj, img, K, cv::noArray(), rvec, tvec, inlier_mat, usac);
+  } catch (const cv::Exception&) {
+    ok = false;  // USAC throws on degenerate input (all points collinear, too few distinct)
+  }
   std::vector<int> inliers;
-  const bool ok = cv::solvePnPRansac(obj, img, K, cv::noArray(), rvec, tvec, false,
-                                     options.max_iterations,
-                                     static_cast<float>(options.reprojection_error_px),
-                                     options.confidence, inliers, cv::SOLVEPNP_EPNP);
+  if (ok) inlier_mat.reshape(1, 1).copyTo(inliers);
   if (!ok || static_cast<int>(inliers.size()) < std::max(options.min_inliers, 4)) return result;
 
   // Levenberg-Marquardt on the inliers only, starting from the EPnP estimate.

@@ -1,6 +1,7 @@
 #pragma once
-// Absolute pose from 3D-2D correspondences: EPnP inside RANSAC (OpenCV), followed by an
-// iterative refinement on the inliers.
+// Absolute pose from 3D-2D correspondences: OpenCV's USAC (P3P samples, EPnP on the consensus set,
+// local optimisation) with a seeded sampler, followed by an iterative refinement on the inliers.
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -15,6 +16,8 @@ struct PnpOptions {
   double reprojection_error_px = 2.0;  // RANSAC inlier threshold on the left image
   double confidence = 0.99;
   int min_inliers = 10;
+  // The sampler's seed: the same seed and input give the same pose (SystemOptions::seed).
+  std::uint32_t seed = 1;
 };
 
 struct PnpResult {

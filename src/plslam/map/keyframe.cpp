@@ -128,7 +128,7 @@ void KeyFrame::erase_connection(KeyFrame* kf) {
 }
 
 void KeyFrame::update_connections(int min_shared) {
-  std::map<KeyFrame*, int> counter;
+  IdMap<KeyFrame, int> counter;
   for (const auto* p : map_points()) {
     if (!p || p->is_bad()) continue;
     for (const auto& [kf, idx] : p->observations()) {
@@ -144,7 +144,7 @@ void KeyFrame::update_connections(int min_shared) {
   if (counter.empty()) return;
   KeyFrame* best = nullptr;
   int best_w = 0;
-  std::map<KeyFrame*, int> kept;
+  IdMap<KeyFrame, int> kept;
   for (const auto& [kf, w] : counter) {
     if (kf->is_bad()) continue;
     if (w > best_w || (w == best_w && best && kf->id() < best->id())) {
@@ -188,7 +188,7 @@ KeyFrame* KeyFrame::parent() const {
   return parent_;
 }
 
-std::set<KeyFrame*> KeyFrame::children() const {
+IdSet<KeyFrame> KeyFrame::children() const {
   std::lock_guard lock(graph_mutex_);
   return children_;
 }
@@ -231,7 +231,7 @@ void KeyFrame::set_bad() {
     if (auto* l = map_line(static_cast<int>(i))) l->erase_observation(this);
   }
   KeyFrame* parent = nullptr;
-  std::set<KeyFrame*> children;
+  IdSet<KeyFrame> children;
   {
     std::lock_guard lock(graph_mutex_);
     weights_.clear();
@@ -247,7 +247,7 @@ void KeyFrame::set_bad() {
   }
   // Spanning-tree repair (as ORB-SLAM2): each child moves to the candidate parent it shares most
   // with; candidates start as this keyframe's parent and grow with every re-parented child.
-  std::set<KeyFrame*> candidates;
+  IdSet<KeyFrame> candidates;
   if (parent) candidates.insert(parent);
   while (!children.empty()) {
     KeyFrame* best_child = nullptr;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "plslam/geometry/se3.h"
+#include "plslam/map/by_id.h"
 #include "plslam/map/frame_data.h"
 
 namespace plslam::map {
@@ -61,7 +62,7 @@ class KeyFrame {
 
   // Spanning tree.
   KeyFrame* parent() const;
-  std::set<KeyFrame*> children() const;
+  IdSet<KeyFrame> children() const;
   void add_child(KeyFrame* kf);
   void erase_child(KeyFrame* kf);
   void change_parent(KeyFrame* kf);
@@ -87,10 +88,10 @@ class KeyFrame {
   std::vector<MapLine*> lines_;
 
   mutable std::mutex graph_mutex_;
-  std::map<KeyFrame*, int> weights_;
+  IdMap<KeyFrame, int> weights_;
   std::vector<KeyFrame*> ordered_;  // covisibles by decreasing weight
   KeyFrame* parent_ = nullptr;
-  std::set<KeyFrame*> children_;
+  IdSet<KeyFrame> children_;
   bool first_connection_ = true;
   bool bad_ = false;
   geometry::SE3 T_cp_;

@@ -9,6 +9,8 @@
 // while local mapping writes it. Member definitions: landmark_impl.h, instantiated by the derived
 // classes' .cpp files.
 #include <map>
+
+#include "plslam/map/by_id.h"
 #include <mutex>
 
 #include <Eigen/Core>
@@ -31,7 +33,7 @@ class Landmark {
   void add_observation(KeyFrame* kf, int index);
   // Removes one; a landmark left with fewer than two observing keyframes turns bad.
   void erase_observation(KeyFrame* kf);
-  std::map<KeyFrame*, int> observations() const;
+  IdMap<KeyFrame, int> observations() const;
   int num_observations() const;
   int index_in(const KeyFrame* kf) const;  // -1 if not observed there
   KeyFrame* reference() const;
@@ -66,7 +68,7 @@ class Landmark {
   const long created_frame_;
   Eigen::Vector3d normal_ = Eigen::Vector3d::Zero();
   cv::Mat descriptor_;
-  std::map<KeyFrame*, int> observations_;
+  IdMap<KeyFrame, int> observations_;
   KeyFrame* reference_;
   double min_distance_ = 0, max_distance_ = 0;
   int visible_ = 1, found_ = 1;

@@ -28,7 +28,7 @@ void Landmark<D>::erase_observation(KeyFrame* kf) {
 }
 
 template <class D>
-std::map<KeyFrame*, int> Landmark<D>::observations() const {
+IdMap<KeyFrame, int> Landmark<D>::observations() const {
   std::lock_guard lock(mutex_);
   return observations_;
 }
@@ -124,7 +124,7 @@ bool Landmark<D>::is_bad() const {
 
 template <class D>
 void Landmark<D>::set_bad() {
-  std::map<KeyFrame*, int> obs;
+  IdMap<KeyFrame, int> obs;
   {
     std::lock_guard lock(mutex_);
     if (bad_) return;
@@ -141,7 +141,7 @@ template <class D>
 void Landmark<D>::replace_with(D* other) {
   D* self = static_cast<D*>(this);
   if (other == self || !other) return;
-  std::map<KeyFrame*, int> obs;
+  IdMap<KeyFrame, int> obs;
   int visible = 0, found = 0;
   {
     std::lock_guard lock(mutex_);

@@ -42,18 +42,14 @@ class Map {
   std::mutex& update_mutex() { return update_mutex_; }
 
  private:
-  struct ById {
-    template <class T>
-    bool operator()(const T* a, const T* b) const { return a->id() < b->id(); }
-  };
   mutable std::mutex mutex_;
   std::mutex update_mutex_;
   std::vector<std::unique_ptr<KeyFrame>> all_keyframes_;
   std::vector<std::unique_ptr<MapPoint>> all_points_;
   std::vector<std::unique_ptr<MapLine>> all_lines_;
-  mutable std::set<KeyFrame*, ById> keyframes_;
-  mutable std::set<MapPoint*, ById> points_;
-  mutable std::set<MapLine*, ById> lines_;
+  mutable IdSet<KeyFrame> keyframes_;
+  mutable IdSet<MapPoint> points_;
+  mutable IdSet<MapLine> lines_;
   long next_keyframe_id_ = 0, next_point_id_ = 0, next_line_id_ = 0;
 };
 

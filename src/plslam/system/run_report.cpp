@@ -39,6 +39,8 @@ nlohmann::json RunReport::to_json(const System& slam) const {
     skipped_json.push_back({{"frame", s.index}, {"timestamp", s.timestamp}, {"reason", s.reason}});
   }
   return {{"complete", complete},
+          {"mode", slam.options().sequential ? "sequential" : "concurrent"},
+          {"seed", slam.options().seed},
           {"input_frames", input_frames},
           {"frames", frames},
           {"initialized_at_frame", init ? nlohmann::json(*init) : nlohmann::json(nullptr)},

@@ -2,6 +2,7 @@
 // The SLAM system: frame extraction, the tracker, and the local mapping thread over one map.
 // The caller's thread is the tracking thread; local mapping runs concurrently (or, with
 // `sequential`, in the tracking thread after each keyframe, for reproducible runs).
+#include <cstdint>
 #include <memory>
 #include <optional>
 
@@ -19,6 +20,10 @@ struct SystemOptions {
   tracking::TrackerOptions tracker;
   mapping::LocalMapperOptions mapper;
   bool sequential = false;
+  // Seed of every random choice (config `system.seed`, recorded in stats.json). Today the
+  // pipeline makes none: tracking, mapping and BA are deterministic. The PnP RANSAC of
+  // relocalization (geometry::PnpOptions::seed) takes it.
+  std::uint32_t seed = 1;
 
   static SystemOptions euroc();
   static SystemOptions kitti();
@@ -50,6 +55,7 @@ class System {
   std::optional<long> initialized_at() const;
   Trajectory keyframe_trajectory() const;
   const map::Map& map() const { return map_; }
+  const SystemOptions& options() const { return options_; }
   const tracking::Tracker& tracker() const { return *tracker_; }
   mapping::LocalMapperStats mapper_stats() const { return mapper_->stats(); }
 

@@ -69,6 +69,12 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
   mapping.get("ba_iterations", o.mapper.ba_iterations);
   mapping.get("culling_redundancy", o.mapper.culling_redundancy);
 
+  const auto system = config.section("system");
+  int seed = static_cast<int>(o.seed);
+  system.get("seed", seed);
+  if (seed < 0) throw InputError(config.source(), "system.seed: must be >= 0");
+  o.seed = static_cast<std::uint32_t>(seed);
+
   config.check_all_used();
   return o;
 }

@@ -10,6 +10,7 @@
 //              velocity_min_frames}
 //   optim:    {line_information}
 //   mapping:  {local_ba, ba_iterations, culling_redundancy}
+//   system:   {seed}
 #include <filesystem>
 #include <optional>
 

@@ -258,7 +258,7 @@ bool Tracker::track_reference_keyframe(Frame& f, TrackStageTimes& t) {
 void Tracker::update_local_map(Frame& f) {
   // Local keyframes: those observing the frame's matches, their best covisibles, and their
   // spanning-tree neighbours.
-  std::map<map::KeyFrame*, int> counter;
+  map::IdMap<map::KeyFrame, int> counter;
   for (std::size_t i = 0; i < f.points.size(); ++i) {
     map::MapPoint* mp = f.points[i];
     if (!mp || mp->is_bad()) {
