@@ -129,6 +129,52 @@ TEST(Map, PointWithOneObservationLeftBecomesBad) {
   EXPECT_EQ(a->map_point(0), nullptr);
 }
 
+// ORB-SLAM's observation count: stereo observations weigh 2, left-only ones 1, and the weight
+// follows additions, re-indexing, removals and replacement.
+TEST(Map, ObservationWeightCountsStereoTwice) {
+  Map map;
+  auto stereo_data = [](long id) {
+    auto d = make_data(id, 10, 2);
+    for (int i = 0; i < 5; ++i) {  // points 0-4 and line 0 are stereo
+      d->u_right[static_cast<std::size_t>(i)] = 100.f;
+      d->depth[static_cast<std::size_t>(i)] = 2.f;
+    }
+    d->lines[0].stereo = true;
+    return d;
+  };
+  KeyFrame* a = map.create_keyframe(stereo_data(0), geometry::SE3());
+  KeyFrame* b = map.create_keyframe(stereo_data(1), geometry::SE3());
+  KeyFrame* c = map.create_keyframe(stereo_data(2), geometry::SE3());
+  MapPoint* p = map.create_point({0, 0, 2}, a, 0);
+  p->add_observation(a, 1);  // stereo
+  EXPECT_EQ(p->observation_weight(), 2);
+  p->add_observation(b, 7);  // left only
+  EXPECT_EQ(p->observation_weight(), 3);
+  p->add_observation(b, 2);  // the same keyframe, now a stereo feature
+  EXPECT_EQ(p->observation_weight(), 4);
+  EXPECT_EQ(p->num_observations(), 2);
+  p->add_observation(c, 8);
+  EXPECT_EQ(p->observation_weight(), 5);
+  p->erase_observation(a);
+  EXPECT_EQ(p->observation_weight(), 3);
+  a->add_map_point(p, 1);
+  b->add_map_point(p, 2);
+  c->add_map_point(p, 8);
+  EXPECT_EQ(b->tracked_map_points(3), 1);
+  EXPECT_EQ(b->tracked_map_points(4), 0);
+
+  MapLine* l = map.create_line({0, 0, 2}, {1, 0, 2}, a, 0);
+  l->add_observation(a, 0);
+  l->add_observation(b, 1);
+  EXPECT_EQ(l->observation_weight(), 3);
+  MapPoint* q = map.create_point({0, 0, 2.1}, c, 2);
+  q->add_observation(c, 3);
+  q->add_observation(a, 4);
+  p->replace_with(q);  // b's stereo observation moves over; c already sees q
+  EXPECT_EQ(p->observation_weight(), 0);
+  EXPECT_EQ(q->observation_weight(), 6);
+}
+
 TEST(Map, MostDistinctiveDescriptorHasSmallestMedianDistance) {
   // A central descriptor, three that each differ from it in 4 other bits, and a far one.
   auto with_bits = [](int from, int to) {

@@ -63,7 +63,7 @@ int KeyFrame::tracked_map_points(int min_obs) const {
   const auto pts = map_points();
   int n = 0;
   for (const auto* p : pts) {
-    if (p && !p->is_bad() && p->num_observations() >= min_obs) ++n;
+    if (p && !p->is_bad() && p->observation_weight() >= min_obs) ++n;
   }
   return n;
 }
@@ -99,7 +99,7 @@ int KeyFrame::tracked_map_lines(int min_obs) const {
   const auto ls = map_lines();
   int n = 0;
   for (const auto* l : ls) {
-    if (l && !l->is_bad() && l->num_observations() >= min_obs) ++n;
+    if (l && !l->is_bad() && l->observation_weight() >= min_obs) ++n;
   }
   return n;
 }

@@ -39,7 +39,8 @@ class KeyFrame {
   void erase_map_point(const MapPoint* p);
   MapPoint* map_point(int index) const;
   std::vector<MapPoint*> map_points() const;  // same size as keypoints; nullptr where none
-  // Map points observed by at least min_obs keyframes (ORB-SLAM2's TrackedMapPoints).
+  // Map points whose observation weight (a stereo observation counts 2) is at least min_obs:
+  // ORB-SLAM2's TrackedMapPoints.
   int tracked_map_points(int min_obs) const;
 
   // Line associations, indexed like data().lines.

@@ -5,6 +5,7 @@
 //   static Derived* slot(const KeyFrame&, int index);
 //   static void set_slot(KeyFrame&, int index, Derived* value);
 //   static cv::Mat descriptor_row(const KeyFrame&, int index);
+//   static bool is_stereo(const KeyFrame&, int index);  // also matched in the right image
 // Owned by the Map; the state is guarded by the landmark's own mutex because tracking reads it
 // while local mapping writes it. Member definitions: landmark_impl.h, instantiated by the derived
 // classes' .cpp files.
@@ -34,7 +35,11 @@ class Landmark {
   // Removes one; a landmark left with fewer than two observing keyframes turns bad.
   void erase_observation(KeyFrame* kf);
   IdMap<KeyFrame, int> observations() const;
-  int num_observations() const;
+  int num_observations() const;  // observing keyframes
+  // ORB-SLAM's observation count: a stereo observation counts 2, a left-only one 1, because a
+  // stereo observation alone fixes the landmark's position. The keyframe decision (tracked map
+  // points of the reference) and the culling rules use this count, as ORB-SLAM2/3 do.
+  int observation_weight() const;
   int index_in(const KeyFrame* kf) const;  // -1 if not observed there
   KeyFrame* reference() const;
 
@@ -69,6 +74,7 @@ class Landmark {
   Eigen::Vector3d normal_ = Eigen::Vector3d::Zero();
   cv::Mat descriptor_;
   IdMap<KeyFrame, int> observations_;
+  int observation_weight_ = 0;
   KeyFrame* reference_;
   double min_distance_ = 0, max_distance_ = 0;
   int visible_ = 1, found_ = 1;

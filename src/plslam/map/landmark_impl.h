@@ -10,8 +10,14 @@ namespace plslam::map {
 
 template <class D>
 void Landmark<D>::add_observation(KeyFrame* kf, int index) {
+  const int weight = D::is_stereo(*kf, index) ? 2 : 1;
   std::lock_guard lock(mutex_);
-  observations_[kf] = index;
+  const auto [it, inserted] = observations_.try_emplace(kf, index);
+  if (!inserted) {
+    observation_weight_ -= D::is_stereo(*kf, it->second) ? 2 : 1;
+    it->second = index;
+  }
+  observation_weight_ += weight;
 }
 
 template <class D>
@@ -19,7 +25,10 @@ void Landmark<D>::erase_observation(KeyFrame* kf) {
   bool now_bad = false;
   {
     std::lock_guard lock(mutex_);
-    if (!observations_.erase(kf)) return;
+    const auto it = observations_.find(kf);
+    if (it == observations_.end()) return;
+    observation_weight_ -= D::is_stereo(*kf, it->second) ? 2 : 1;
+    observations_.erase(it);
     if (reference_ == kf && !observations_.empty()) reference_ = observations_.begin()->first;
     // Seen by fewer than two keyframes, it carries no constraint between them: drop it.
     now_bad = observations_.size() <= 1 && !bad_;
@@ -37,6 +46,12 @@ template <class D>
 int Landmark<D>::num_observations() const {
   std::lock_guard lock(mutex_);
   return static_cast<int>(observations_.size());
+}
+
+template <class D>
+int Landmark<D>::observation_weight() const {
+  std::lock_guard lock(mutex_);
+  return observation_weight_;
 }
 
 template <class D>
@@ -130,6 +145,7 @@ void Landmark<D>::set_bad() {
     if (bad_) return;
     bad_ = true;
     obs.swap(observations_);
+    observation_weight_ = 0;
   }
   D* self = static_cast<D*>(this);
   for (const auto& [kf, idx] : obs) {
@@ -148,6 +164,7 @@ void Landmark<D>::replace_with(D* other) {
     if (bad_) return;
     bad_ = true;
     obs.swap(observations_);
+    observation_weight_ = 0;
     visible = visible_;
     found = found_;
     replaced_by_ = other;

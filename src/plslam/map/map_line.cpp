@@ -43,6 +43,10 @@ void MapLine::set_slot(KeyFrame& kf, int index, MapLine* value) {
 
 cv::Mat MapLine::descriptor_row(const KeyFrame& kf, int index) { return kf.data().line_descriptors.row(index); }
 
+bool MapLine::is_stereo(const KeyFrame& kf, int index) {
+  return kf.data().lines.at(static_cast<std::size_t>(index)).stereo;
+}
+
 void MapLine::update_normal_and_depth() {
   const auto obs = observations();
   KeyFrame* ref = reference();

@@ -24,6 +24,7 @@ class MapLine : public Landmark<MapLine> {
   static MapLine* slot(const KeyFrame& kf, int index);
   static void set_slot(KeyFrame& kf, int index, MapLine* value);
   static cv::Mat descriptor_row(const KeyFrame& kf, int index);
+  static bool is_stereo(const KeyFrame& kf, int index);
 
  private:
   Eigen::Vector3d start_, end_;

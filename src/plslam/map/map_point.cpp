@@ -34,6 +34,10 @@ void MapPoint::set_slot(KeyFrame& kf, int index, MapPoint* value) {
 
 cv::Mat MapPoint::descriptor_row(const KeyFrame& kf, int index) { return kf.data().descriptors.row(index); }
 
+bool MapPoint::is_stereo(const KeyFrame& kf, int index) {
+  return kf.data().u_right.at(static_cast<std::size_t>(index)) >= 0;
+}
+
 void MapPoint::update_normal_and_depth() {
   const auto obs = observations();
   KeyFrame* ref = reference();

@@ -25,6 +25,7 @@ class MapPoint : public Landmark<MapPoint> {
   static MapPoint* slot(const KeyFrame& kf, int index);
   static void set_slot(KeyFrame& kf, int index, MapPoint* value);
   static cv::Mat descriptor_row(const KeyFrame& kf, int index);
+  static bool is_stereo(const KeyFrame& kf, int index);
 
  private:
   Eigen::Vector3d position_;
