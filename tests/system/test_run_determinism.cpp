@@ -68,5 +68,28 @@ TEST(RunDeterminism, SequentialRenderedRunsAreByteIdentical) {
   expect_identical_sequential_runs(seq, "");
 }
 
+// --repeat N: N runs in run-1..N and their ATE spread in repeat.json; sequential runs have none.
+TEST(RunDeterminism, RepeatReportsTheSpreadOfSequentialRuns) {
+  test::TempDir tmp;
+  const auto seq = tmp.path() / "office";
+  ASSERT_EQ(test::run_cli("synth --out \"" + seq.string() + "\" --scene office --frames 40 --seed 4").exit_code, 0);
+  const auto out = tmp.path() / "rep";
+  const auto r = test::run_cli("run \"" + seq.string() + "\" --sequential --quiet --repeat 2 --out \"" + out.string() + "\"");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(out / "repeat.json");
+  ASSERT_TRUE(in);
+  const auto j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["runs"].size(), 2u);
+  EXPECT_EQ(j["completed_runs"], 2);
+  EXPECT_EQ(j["ate_rmse_m"]["max_over_min"].get<double>(), 1.0);
+  EXPECT_GT(j["ate_rmse_m"]["median"].get<double>(), 0.0);
+  EXPECT_LT(j["ate_rmse_m"]["median"].get<double>(), 0.05);
+  EXPECT_TRUE(bytes_of(out / "run-1" / "trajectory.tum") == bytes_of(out / "run-2" / "trajectory.tum"));
+  EXPECT_NE(r.out.find("ATE over 2 runs: median"), std::string::npos) << r.out;
+
+  const auto bad = test::run_cli("run \"" + seq.string() + "\" --repeat 0 --out \"" + (tmp.path() / "bad").string() + "\"");
+  EXPECT_EQ(bad.exit_code, 2);
+}
+
 }  // namespace
 }  // namespace plslam

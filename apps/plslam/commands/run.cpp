@@ -48,11 +48,12 @@ struct RunArgs {
   bool quiet = false;
   bool realtime = false;
   bool sequential = false;
+  int repeat = 1;
 };
 
-int run_slam(const RunArgs& args) {
+// One run into `out_dir`; its stats.json content is left in `stats_out`.
+int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats_out) {
   // Checked before any frame: a bad --out must not be found only when the outputs are written.
-  const fs::path out_dir = args.out;
   io::prepare_output_folder(out_dir);
   const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
   auto options = system::load_system_options(
@@ -115,7 +116,8 @@ int run_slam(const RunArgs& args) {
   if (!slam.initialized_at()) {
     // No pose was ever tracked: an identity trajectory would look perfect to an evaluator, so
     // none is written; stats.json says what happened.
-    const auto stats_text = with_interruption(report.to_json(slam)).dump(2);
+    stats_out = with_interruption(report.to_json(slam));
+    const auto stats_text = stats_out.dump(2);
     io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats_text << "\n"; });
     if (!fatal.empty()) throw InputError("", fatal);
     if (app::stop_requested()) return app::stop_exit_code();
@@ -157,10 +159,51 @@ int run_slam(const RunArgs& args) {
     }
   }
   io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats.dump(2) << "\n"; });
+  stats_out = stats;
   std::cout << report.summary(slam);
   spdlog::info("outputs written to {}", out_dir.string());
   if (!fatal.empty()) throw InputError("", fatal);
   return app::stop_requested() ? app::stop_exit_code() : 0;
+}
+
+// --repeat N: N runs into DIR/run-1 ... DIR/run-N, and DIR/repeat.json with the ATE of each and
+// their median, min, max and max/min, so that the run-to-run spread is visible wherever an
+// accuracy is quoted. Stops at the first failing or interrupted run.
+int run_repeated(const RunArgs& args) {
+  const fs::path out_dir = args.out;
+  io::prepare_output_folder(out_dir);
+  std::vector<double> ates;
+  nlohmann::json runs = nlohmann::json::array();
+  int rc = 0;
+  for (int i = 1; i <= args.repeat && rc == 0 && !app::stop_requested(); ++i) {
+    const fs::path dir = out_dir / fmt::format("run-{}", i);
+    spdlog::info("run {}/{} -> {}", i, args.repeat, dir.string());
+    nlohmann::json stats;
+    rc = run_slam(args, dir, stats);
+    nlohmann::json entry = {{"run", i}, {"folder", dir.filename().string()}, {"exit_code", rc}};
+    if (stats.contains("accuracy") && stats["accuracy"].contains("ape_trans_m")) {
+      const double ate = stats["accuracy"]["ape_trans_m"]["rmse"].get<double>();
+      entry["ate_rmse_m"] = ate;
+      if (rc == 0) ates.push_back(ate);
+    }
+    if (stats.contains("keyframes")) entry["keyframes"] = stats["keyframes"];
+    runs.push_back(entry);
+  }
+  nlohmann::json summary = {{"runs", runs}, {"requested", args.repeat}, {"completed_runs", ates.size()}};
+  if (!ates.empty()) {
+    std::vector<double> sorted = ates;
+    std::sort(sorted.begin(), sorted.end());
+    const std::size_t n = sorted.size();
+    const double median = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+    summary["ate_rmse_m"] = {{"median", median}, {"min", sorted.front()}, {"max", sorted.back()},
+                             {"max_over_min", sorted.front() > 0 ? sorted.back() / sorted.front() : 0.0}};
+    std::cout << fmt::format("ATE over {} runs: median {:.4f} m, min {:.4f}, max {:.4f} (max/min {:.2f})\n", n, median,
+                             sorted.front(), sorted.back(), sorted.front() > 0 ? sorted.back() / sorted.front() : 0.0);
+  } else {
+    std::cout << "no ATE: the dataset has no ground truth, or no run completed\n";
+  }
+  io::write_file_atomically(out_dir / "repeat.json", [&](std::ostream& o) { o << summary.dump(2) << "\n"; });
+  return rc;
 }
 
 CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](CLI::App& sub) {
@@ -174,7 +217,14 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                            sub.add_flag("--realtime", args->realtime, "Pace the input at the dataset's frame rate");
                            sub.add_flag("--sequential", args->sequential,
                                         "Run local mapping in the tracking thread (reproducible runs)");
-                           return std::function<int()>([args] { return run_slam(*args); });
+                           sub.add_option("--repeat", args->repeat,
+                                          "Run N times into DIR/run-1..N and report the ATE's median, min and max")
+                               ->check(CLI::Range(1, 1000));
+                           return std::function<int()>([args] {
+                             if (args->repeat > 1) return run_repeated(*args);
+                             nlohmann::json stats;
+                             return run_slam(*args, args->out, stats);
+                           });
                          }});
 
 }  // namespace
