@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <fstream>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -69,6 +70,40 @@ TEST(EvalCli, JsonHasExactlyTheDocumentedKeys) {
   EXPECT_GT(j["ape_trans_m"]["rmse"].get<double>(), 0.005);
   EXPECT_LT(j["ape_trans_m"]["rmse"].get<double>(), 0.03);
   EXPECT_NE(r.err.find("matched 300 pose pairs"), std::string::npos) << r.err;
+}
+
+// tracking.png from a run's frames.csv: drawn with the keyframes; a broken log is refused.
+TEST(EvalCli, PlotsTheFrameLogNextToTheError) {
+  Files f;
+  const Trajectory g = test::helix(300);
+  std::string csv = "frame,timestamp,state,tracked,keyframe,keyframe_reason,point_inliers,line_inliers,reference_tracked,"
+                    "keyframe_threshold,delta_pid,speed_mps,tracked_close,untracked_close,local_keyframes,local_points,"
+                    "local_lines,stereo_points,stereo_lines,tracking_ms\n";
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const bool kf = i % 10 == 0;
+    csv += fmt::format("{},{:.9f},OK,1,{},{},{},{},400,{},0,1.0,150,200,5,2000,100,800,120,20.0\n", i, g[i].t, kf ? 1 : 0,
+                       kf ? "inlier-ratio" : "", 300 + static_cast<int>(i % 10) * 10, 40, 300);
+  }
+  const auto frames = f.dir.path() / "frames.csv";
+  write_text(frames, csv);
+  const auto dir = plslam::test::artifacts_dir() / "eval_cli_tracking";
+  const auto r = run_cli("eval --gt " + q(f.gt) + " --est " + q(f.est) + " --plot " + q(dir) + " --frames " + q(frames));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const cv::Mat img = cv::imread((dir / "tracking.png").string());
+  ASSERT_FALSE(img.empty());
+  EXPECT_EQ(img.rows, 1200);
+  cv::Mat red;  // keyframe markers are red (BGR 40, 39, 214)
+  cv::inRange(img, cv::Scalar(30, 29, 200), cv::Scalar(50, 49, 230), red);
+  EXPECT_GT(cv::countNonZero(red), 300);
+
+  write_text(frames, "frame,timestamp,keyframe\n0,1.0\n");
+  const auto bad = run_cli("eval --gt " + q(f.gt) + " --est " + q(f.est) + " --plot " + q(dir) + " --frames " + q(frames));
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("frames.csv: line 2: 2 cells, the header has 3"), std::string::npos) << bad.err;
+  write_text(frames, "a,b\n1,2\n");
+  EXPECT_NE(run_cli("eval --gt " + q(f.gt) + " --est " + q(f.est) + " --plot " + q(dir) + " --frames " + q(frames)).err.find("no 'frame' column"),
+            std::string::npos);
+  EXPECT_EQ(run_cli("eval --gt " + q(f.gt) + " --est " + q(f.est) + " --frames " + q(frames)).exit_code, 2);  // needs --plot
 }
 
 TEST(EvalCli, HumanReadableByDefault) {

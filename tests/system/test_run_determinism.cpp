@@ -1,6 +1,7 @@
 // --sequential reproduces: two runs on the same input give byte-identical trajectories and maps,
 // and the same stats.json apart from timings (README "Reproducible runs"). Before map objects were
 // ordered by id instead of address, two identical runs of KITTI 06 differed from frame 7 on.
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -53,6 +54,10 @@ void expect_identical_sequential_runs(const fs::path& seq, const std::string& ex
   EXPECT_EQ(sa["mode"], "sequential");
   EXPECT_EQ(sa["seed"], 1);
   EXPECT_GT(sa["keyframes"].get<int>(), 3);  // long enough for local BA, culling and fusion to act
+  // frames.csv: a header and one row per processed frame (its timing column differs between runs).
+  const std::string log = bytes_of(outs[0] / "frames.csv");
+  EXPECT_EQ(log.rfind("frame,timestamp,state,tracked,keyframe,", 0), 0u);
+  EXPECT_EQ(static_cast<int>(std::count(log.begin(), log.end(), '\n')), sa["frames"].get<int>() + 1);
 }
 
 TEST(RunDeterminism, SequentialKittiRunsAreByteIdentical) {

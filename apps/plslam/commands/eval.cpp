@@ -28,6 +28,7 @@ struct Options {
   bool kitti_metric = false;
   bool json = false;
   std::string plot_dir;
+  std::string frames;  // frames.csv of the run, for tracking.png
 };
 
 plslam::io::TrajectoryFormat resolve_format(const std::string& name, const std::string& path) {
@@ -36,6 +37,7 @@ plslam::io::TrajectoryFormat resolve_format(const std::string& name, const std::
 }
 
 int run(const Options& o) {
+  if (!o.frames.empty() && o.plot_dir.empty()) throw plslam::InputError(o.frames, "--frames needs --plot DIR");
   using plslam::io::TrajectoryFormat;
   const TrajectoryFormat gt_format = resolve_format(o.gt_format, o.gt);
   const TrajectoryFormat est_format = resolve_format(o.est_format, o.est);
@@ -86,6 +88,10 @@ int run(const Options& o) {
     for (const auto& p : plslam::eval::write_plots(result, o.plot_dir, plot_options)) {
       spdlog::info("wrote {}", p.string());
     }
+    if (!o.frames.empty()) {
+      const auto p = plslam::eval::write_tracking_plot(result, plslam::eval::read_frame_log(o.frames), o.plot_dir, plot_options);
+      spdlog::info("wrote {}", p.string());
+    }
   }
   if (o.json) {
     std::cout << plslam::eval::to_json(result).dump(2) << "\n";
@@ -120,6 +126,8 @@ plslam::cli::CommandRegistration reg({"eval", "Evaluate an estimated trajectory 
     sub.add_flag("--kitti-metric", o->kitti_metric, "Also compute the KITTI odometry metric");
     sub.add_flag("--json", o->json, "Print the results as JSON on stdout");
     sub.add_option("--plot", o->plot_dir, "Write trajectory.png, ape.png and rpe.png into DIR");
+    sub.add_option("--frames", o->frames,
+                   "With --plot: the run's frames.csv, plotted in tracking.png next to the APE (inliers, keyframes, local map)");
     return std::function<int()>([o] { return run(*o); });
   }});
 

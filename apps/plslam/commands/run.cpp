@@ -138,6 +138,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     io::write_trajectory(out_dir / "trajectory.kitti", aligned.poses, io::TrajectoryFormat::kKitti);
   }
   io::write_trajectory(out_dir / "keyframes.tum", slam.keyframe_trajectory(), io::TrajectoryFormat::kTum);
+  io::write_file_atomically(out_dir / "frames.csv", [&](std::ostream& o) { report.write_frames_csv(o); });
   std::vector<Eigen::Vector3d> points;
   for (const auto* p : slam.map().points()) points.push_back(p->position());
   io::write_ply_points(out_dir / "map_points.ply", points);

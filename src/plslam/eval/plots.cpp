@@ -142,4 +142,74 @@ std::vector<std::filesystem::path> write_plots(const EvalResult& r, const std::f
   return written;
 }
 
+std::filesystem::path write_tracking_plot(const EvalResult& r, const FrameLog& log, const std::filesystem::path& dir,
+                                          const PlotOptions& options) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError(dir.string(), "cannot create the plot folder: " + ec.message());
+  const auto stamps = log.numbers(options.x_is_frame ? "frame" : "timestamp");
+  const auto keyframe = log.numbers("keyframe");
+  const auto tracked = log.numbers("tracked");
+  const double t0 = options.x_is_frame || r.gt.empty() ? 0.0 : r.gt.front().t;
+  auto series = [&](const std::string& column) {
+    const auto v = log.numbers(column);
+    std::vector<cv::Point2d> pts;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (tracked[i] > 0) pts.emplace_back(stamps[i] - t0, v[i]);
+    }
+    return pts;
+  };
+  cv::Mat img(1200, 1100, CV_8UC3);
+  const int h = img.rows / 3;
+
+  Chart ape;
+  ape.set_title(fmt::format("APE ({}) and keyframes (red)", alignment_text(r)));
+  ape.set_xlabel(time_axis(options));
+  ape.set_ylabel("APE [m]");
+  ape.set_y_from_zero(true);
+  std::vector<cv::Point2d> ape_pts;
+  for (std::size_t i = 0; i < r.ape_trans_m.size(); ++i) ape_pts.emplace_back(time_of(r.gt, i, options), r.ape_trans_m[i]);
+  // A keyframe is marked on the APE curve at the paired pose nearest in time.
+  int marked = 0;
+  for (std::size_t i = 0; i < keyframe.size(); ++i) {
+    if (keyframe[i] <= 0 || ape_pts.empty()) continue;
+    const double t = stamps[i] - t0;
+    const auto it = std::min_element(ape_pts.begin(), ape_pts.end(), [t](const cv::Point2d& a, const cv::Point2d& b) {
+      return std::abs(a.x - t) < std::abs(b.x - t);
+    });
+    ape.add_marker(*it, kRed, marked++ == 0 ? fmt::format("keyframe ({})", static_cast<int>(std::count_if(keyframe.begin(), keyframe.end(), [](double k) { return k > 0; }))) : "");
+  }
+  ape.add_line(std::move(ape_pts), {kBlue, 1, false}, "APE");
+  cv::Mat p1 = img(cv::Rect(0, 0, img.cols, h));
+  ape.draw(p1);
+
+  Chart inl;
+  inl.set_title("Tracked inliers and the keyframe rule (a keyframe when inliers < threshold)");
+  inl.set_xlabel(time_axis(options));
+  inl.set_ylabel("count");
+  inl.set_y_from_zero(true);
+  inl.add_line(series("point_inliers"), {kBlue, 1, false}, "point inliers");
+  inl.add_line(series("line_inliers"), {kOrange, 1, false}, "line inliers");
+  inl.add_line(series("reference_tracked"), {kGrey, 1, false}, "reference keyframe's tracked");
+  inl.add_line(series("keyframe_threshold"), {kRed, 1, true}, "threshold");
+  cv::Mat p2 = img(cv::Rect(0, h, img.cols, h));
+  inl.draw(p2);
+
+  Chart loc;
+  loc.set_title("Local map and stereo depth use");
+  loc.set_xlabel(time_axis(options));
+  loc.set_ylabel("count");
+  loc.set_y_from_zero(true);
+  loc.add_line(series("local_points"), {kBlue, 1, false}, "local map points");
+  loc.add_line(series("local_lines"), {kOrange, 1, false}, "local map lines");
+  loc.add_line(series("tracked_close"), {kGreen, 1, false}, "close stereo points tracked");
+  loc.add_line(series("untracked_close"), {kPurple, 1, false}, "close stereo points not in the map");
+  cv::Mat p3 = img(cv::Rect(0, 2 * h, img.cols, img.rows - 2 * h));
+  loc.draw(p3);
+
+  const auto path = dir / "tracking.png";
+  save(img, path);
+  return path;
+}
+
 }  // namespace plslam::eval

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "plslam/eval/evaluate.h"
+#include "plslam/eval/frame_log.h"
 
 namespace plslam::eval {
 
@@ -19,5 +20,11 @@ std::pair<int, int> top_view_axes(const Trajectory& gt);
 // paths. Throws InputError when a file cannot be written.
 std::vector<std::filesystem::path> write_plots(const EvalResult& r, const std::filesystem::path& dir,
                                                const PlotOptions& options = {});
+
+// tracking.png: three panels over the same time axis, to see where and why the error grows.
+// APE with the keyframes marked; tracked point and line inliers against the keyframe rule's
+// threshold; the local map's size and the close stereo points tracked. Returns the path written.
+std::filesystem::path write_tracking_plot(const EvalResult& r, const FrameLog& log, const std::filesystem::path& dir,
+                                          const PlotOptions& options = {});
 
 }  // namespace plslam::eval

@@ -10,7 +10,27 @@
 #include "plslam/eval/evaluate.h"
 
 namespace plslam::system {
+const char* RunReport::frames_csv_header() {
+  return "frame,timestamp,state,tracked,keyframe,keyframe_reason,point_inliers,line_inliers,reference_tracked,"
+         "keyframe_threshold,delta_pid,speed_mps,tracked_close,untracked_close,local_keyframes,local_points,"
+         "local_lines,stereo_points,stereo_lines,tracking_ms";
+}
+
+void RunReport::write_frames_csv(std::ostream& out) const {
+  out << frames_csv_header() << "\n";
+  for (const auto& row : frame_rows) out << row << "\n";
+}
+
 void RunReport::add(const FrameResult& r) {
+  const auto& in = r.track.keyframe_inputs;
+  const auto& d = r.track.decision;
+  frame_rows.push_back(fmt::format(
+      "{},{:.9f},{},{},{},{},{},{},{},{:.2f},{:.2f},{:.3f},{},{},{},{},{},{},{},{:.3f}", r.frame_id, r.timestamp,
+      tracking::to_string(r.track.state), r.track.tracked ? 1 : 0, r.track.keyframe ? 1 : 0,
+      r.track.keyframe ? (r.track.decision.insert ? tracking::to_string(d.reason) : "new-map") : "", r.track.point_inliers, r.track.line_inliers,
+      in.reference_tracked, d.threshold, d.delta_pid, d.speed, in.tracked_close, in.untracked_close,
+      r.track.local_keyframes, r.track.local_points, r.track.local_lines, r.extraction.stereo_points,
+      r.extraction.stereo_lines, r.tracking_ms));
   ++frames;
   if (r.track.tracked) ++tracked_frames;
   tracking_ms.push_back(r.tracking_ms);

@@ -20,8 +20,13 @@ struct RunReport {
   std::vector<io::SkippedFrame> skipped;   // unreadable or blank frames, left out
   std::vector<std::size_t> untracked_lines;  // input frames whose trajectory.kitti line is not tracked
   bool complete = false;                   // every input frame was reached
+  std::vector<std::string> frame_rows;     // frames.csv, one row per processed frame
 
   void add(const FrameResult& r);
+  // frames.csv: per frame, what tracking saw and decided (inliers, the keyframe rule's inputs,
+  // local map size, stereo features, time), to find where and why a run's error grows.
+  static const char* frames_csv_header();
+  void write_frames_csv(std::ostream& out) const;
   // Counts and ids of the frames tracked, lost, before initialisation and skipped (from the
   // tracker's records), timings, and the map's size.
   nlohmann::json to_json(const System& slam) const;

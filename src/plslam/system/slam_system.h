@@ -32,6 +32,8 @@ struct SystemOptions {
 };
 
 struct FrameResult {
+  long frame_id = 0;      // the frame's index in the input
+  double timestamp = 0;   // seconds
   tracking::TrackResult track;
   tracking::FrameTimings extraction;
   double tracking_ms = 0;  // images in to pose out

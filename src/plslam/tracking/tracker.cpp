@@ -89,6 +89,10 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       velocity_dt_ = f.data->timestamp - last_->data->timestamp;
       const auto inputs = keyframe_inputs(f, result.point_inliers, result.line_inliers);
       result.decision = policy_.decide(inputs);
+      result.keyframe_inputs = inputs;
+      result.local_keyframes = static_cast<int>(local_keyframes_.size());
+      result.local_points = static_cast<int>(local_points_.size());
+      result.local_lines = static_cast<int>(local_lines_.size());
       if (result.decision.insert) {
         create_keyframe(f);
         policy_.keyframe_inserted(inputs);

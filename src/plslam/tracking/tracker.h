@@ -58,6 +58,8 @@ struct TrackResult {
   int line_inliers = 0;
   bool keyframe = false;
   KeyframeDecision decision;
+  KeyframeInputs keyframe_inputs;  // what the decision saw (tracked frames only)
+  int local_keyframes = 0, local_points = 0, local_lines = 0;  // the local map tracked against
   TrackStageTimes times;
 };
 
