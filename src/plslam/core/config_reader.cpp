@@ -103,7 +103,10 @@ void ConfigReader::get(const std::string& key, std::string& value) const {
 void ConfigReader::collect_unused(const YAML::Node& node, const std::string& prefix, std::string& first) const {
   if (!first.empty() || !node.IsMap()) return;
   for (const auto& kv : node) {
-    const std::string key = prefix.empty() ? kv.first.as<std::string>() : prefix + "." + kv.first.as<std::string>();
+    // A key that is itself a map or a list ({a: 1}: 2) is never one plslam reads (found by fuzzing:
+    // tests/fuzz/corpus/config/non_scalar_key.yaml).
+    const std::string name = kv.first.IsScalar() ? kv.first.Scalar() : "<a map or list used as a key>";
+    const std::string key = prefix.empty() ? name : prefix + "." + name;
     if (!state_->used.count(key)) {
       first = key;
       return;

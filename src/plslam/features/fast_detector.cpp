@@ -93,8 +93,14 @@ struct V {
 #include "plslam/features/fast_kernel.inc"
 }  // namespace sse2
 
+// AVX2 for these functions only (chosen at run time); clang spells the pragma differently (the
+// fuzz targets build the library with clang).
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 namespace avx2 {
 struct V {
   using T = __m256i;
@@ -113,7 +119,11 @@ struct V {
 };
 #include "plslam/features/fast_kernel.inc"
 }  // namespace avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 #endif
 
 struct Kernels {

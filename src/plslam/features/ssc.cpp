@@ -199,8 +199,12 @@ CornerExtent corner_extent_portable(const FastCorners& corners) {
 }
 
 #ifdef PLSLAM_SSC_AVX2
+#if defined(__clang__)  // clang spells GCC's target pragma differently (fuzz builds use clang)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 // As corner_extent_portable, 16 coordinates or 32 scores per instruction.
 CornerExtent corner_extent_avx2(const FastCorners& corners) {
   const std::size_t n = corners.size();
@@ -239,7 +243,11 @@ CornerExtent corner_extent_avx2(const FastCorners& corners) {
   e.max_score = max_s;
   return e;
 }
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 #endif
 
 bool use_avx2();
@@ -378,14 +386,22 @@ inline void gather_kept_impl(const SortedCandidates& sorted, const ScoreRuns& ru
 }
 
 #ifdef PLSLAM_SSC_AVX2
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("popcnt"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("popcnt")
+#endif
 // The same, inlined here so that the popcounts become POPCNT instructions.
 [[gnu::flatten]] void gather_kept_popcnt(const SortedCandidates& sorted, const ScoreRuns& runs, const int* slots, int n,
                                          FastCorners& out, Workspace& ws) {
   gather_kept_impl(sorted, runs, slots, n, out, ws);
 }
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 #endif
 
 void gather_kept(const SortedCandidates& sorted, const ScoreRuns& runs, const int* slots, int n, FastCorners& out,
@@ -482,8 +498,12 @@ int scan_portable(const SortedCandidates& sorted, const Grid& grid, cv::Size siz
 }
 
 #ifdef PLSLAM_SSC_AVX2
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 // AVX2 scan: cells of 8 candidates at once by the float formula (no tables to fill per pass),
 // their cover state by one gather.
 int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, uint8_t stamp, int limit, int* kept) {
@@ -514,7 +534,11 @@ int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, uint
   }
   return count;
 }
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 #endif
 
 bool use_avx2() {

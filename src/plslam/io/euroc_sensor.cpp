@@ -62,6 +62,7 @@ std::vector<double> numbers(const YAML::Node& node, const char* key, std::size_t
 Eigen::Isometry3d parse_T_BS(const YAML::Node& root, const fs::path& path) {
   const auto T = root["T_BS"];
   if (!T) throw InputError(path.string(), "missing 'T_BS'");
+  if (!T.IsMap()) throw InputError(path.string(), "'T_BS' is not a map with rows, cols and data");
   const auto d = numbers(T["data"], "T_BS.data", 16, path);
   Eigen::Matrix4d M;
   for (int r = 0; r < 4; ++r)
@@ -78,16 +79,27 @@ Eigen::Isometry3d parse_T_BS(const YAML::Node& root, const fs::path& path) {
   return iso;
 }
 
-}  // namespace
+// yaml-cpp throws on a value of the wrong shape (a list where a string is expected, a key on a
+// scalar): that is the file's problem, reported as one line naming it (found by fuzzing,
+// tests/fuzz/corpus/euroc_sensor/).
+template <class F>
+auto with_yaml_errors_as_input_errors(const fs::path& path, F&& body) {
+  try {
+    return body();
+  } catch (const YAML::Exception& e) {
+    throw InputError(path.string(), "malformed sensor.yaml: " + e.msg);
+  }
+}
 
-EurocCameraSensor read_euroc_camera_yaml(const fs::path& path) {
-  const YAML::Node root = load_yaml(path);
+EurocCameraSensor parse_camera_yaml(const YAML::Node& root, const fs::path& path) {
   EurocCameraSensor s;
   s.T_BS = parse_T_BS(root, path);
   const auto res = numbers(root["resolution"], "resolution", 2, path);
+  if (!(res[0] >= 1 && res[0] <= 100000 && res[1] >= 1 && res[1] <= 100000) || res[0] != std::floor(res[0]) ||
+      res[1] != std::floor(res[1]))
+    throw InputError(path.string(), "resolution must be two whole numbers in [1, 100000]");
   s.width = static_cast<int>(res[0]);
   s.height = static_cast<int>(res[1]);
-  if (s.width <= 0 || s.height <= 0) throw InputError(path.string(), "resolution must be positive");
   if (root["camera_model"] && root["camera_model"].as<std::string>() != "pinhole") {
     throw InputError(path.string(), "unsupported camera_model '" + root["camera_model"].as<std::string>() + "'");
   }
@@ -107,6 +119,13 @@ EurocCameraSensor read_euroc_camera_yaml(const fs::path& path) {
   return s;
 }
 
+}  // namespace
+
+EurocCameraSensor read_euroc_camera_yaml(const fs::path& path) {
+  const YAML::Node root = load_yaml(path);
+  return with_yaml_errors_as_input_errors(path, [&] { return parse_camera_yaml(root, path); });
+}
+
 Trajectory body_to_sensor(const Trajectory& body, const Eigen::Isometry3d& T_BS) {
   Trajectory out;
   out.reserve(body.size());
@@ -114,6 +133,9 @@ Trajectory body_to_sensor(const Trajectory& body, const Eigen::Isometry3d& T_BS)
   return out;
 }
 
-Eigen::Isometry3d read_euroc_T_BS(const fs::path& path) { return parse_T_BS(load_yaml(path), path); }
+Eigen::Isometry3d read_euroc_T_BS(const fs::path& path) {
+  const YAML::Node root = load_yaml(path);
+  return with_yaml_errors_as_input_errors(path, [&] { return parse_T_BS(root, path); });
+}
 
 }  // namespace plslam::io

@@ -20,7 +20,14 @@ cv::Mat load_grey_image(const std::filesystem::path& path) {
   const std::vector<uchar> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (bytes.empty()) throw InputError(path.string(), "empty image file");
   // imdecode returns an empty Mat (and libpng may print a warning) for corrupt or truncated data.
-  cv::Mat img = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+  cv::Mat img;
+  try {
+    img = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    // OpenCV asserts on headers it refuses, e.g. a PGM claiming 99999 x 99999 pixels (found by
+    // fuzzing, tests/fuzz/corpus/image/pgm_huge_header): still bad input, not an internal error.
+    throw InputError(path.string(), "undecodable image header (" + e.err + ")");
+  }
   if (img.empty()) throw InputError(path.string(), "corrupt or truncated image");
   if (img.depth() != CV_8U) throw InputError(path.string(), "expected an 8-bit image");
   if (img.channels() == 3) {

@@ -181,7 +181,7 @@ bool linearize_line(const Context& c, const StereoLineObservation& o,
 
 // Where the two landmark kinds differ: their arrays in the problem and in the state.
 struct PointKind {
-  static constexpr int R = 3, N = 3;
+  static constexpr int N = 3;  // parameters per landmark
   using Obs = StereoPointObservation;
   using Vec = Eigen::Vector3d;
   static const std::vector<Obs>& observations(const BaProblem& p) { return p.point_observations; }
@@ -196,7 +196,7 @@ struct PointKind {
 };
 
 struct LineKind {
-  static constexpr int R = 4, N = 6;
+  static constexpr int N = 6;
   using Obs = StereoLineObservation;
   using Vec = Vector6d;
   static const std::vector<Obs>& observations(const BaProblem& p) { return p.line_observations; }

@@ -27,8 +27,12 @@ void update_portable(int m, const int* cam, const double* Y, const double* W, do
 #ifdef PLSLAM_SCHUR_X86
 // Only intrinsics on raw arrays below: no Eigen (or other inline library) code is instantiated for
 // AVX2, so no AVX2 copy of a shared inline function can reach the portable callers at link time.
+#if defined(__clang__)  // clang spells GCC's target pragma differently (fuzz builds use clang)
+#pragma clang attribute push(__attribute__((target("avx2,fma"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
+#endif
 namespace avx2 {
 #include "plslam/optim/schur_kernel_pairs.inc"
 }  // namespace avx2
@@ -58,7 +62,11 @@ void update_avx2(int m, const int* cam, const double* Y, const double* W, double
     }
   });
 }
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 #endif
 
 }  // namespace
