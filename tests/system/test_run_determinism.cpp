@@ -58,6 +58,13 @@ void expect_identical_sequential_runs(const fs::path& seq, const std::string& ex
   const std::string log = bytes_of(outs[0] / "frames.csv");
   EXPECT_EQ(log.rfind("frame,timestamp,state,tracked,keyframe,", 0), 0u);
   EXPECT_EQ(static_cast<int>(std::count(log.begin(), log.end(), '\n')), sa["frames"].get<int>() + 1);
+  // Rows carry the input index and the timestamp: the last row is frame N-1, stamped after the first.
+  const auto last_row = log.substr(log.rfind('\n', log.size() - 2) + 1);
+  EXPECT_EQ(last_row.rfind(std::to_string(sa["frames"].get<int>() - 1) + ",", 0), 0u) << last_row;
+  const auto second_row = log.substr(log.find('\n') + 1);
+  const double t0 = std::stod(second_row.substr(second_row.find(',') + 1));
+  const double t_last = std::stod(last_row.substr(last_row.find(',') + 1));
+  EXPECT_GT(t_last, t0);
 }
 
 TEST(RunDeterminism, SequentialKittiRunsAreByteIdentical) {

@@ -55,6 +55,8 @@ System::~System() { finish(); }
 FrameResult System::process(const io::StereoFrame& frame) {
   const auto t0 = std::chrono::steady_clock::now();
   FrameResult r;
+  r.frame_id = static_cast<long>(frame.index);
+  r.timestamp = frame.timestamp;
   // The id is the frame's place in the input, so skipped frames leave gaps instead of shifting
   // every later frame (the keyframe policy counts frames by id, the outputs align by it).
   auto data = extractor_.extract(static_cast<long>(frame.index), frame.timestamp, frame.left, frame.right, &r.extraction);
