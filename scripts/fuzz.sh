@@ -48,8 +48,9 @@ for t in "${targets[@]}"; do
   execs=$(sed -nE 's/^stat::number_of_executed_units: *([0-9]+)/\1/p' "$log" | tail -1)
   cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -1 | cut -d' ' -f2)
   ft=$(grep -oE 'ft: [0-9]+' "$log" | tail -1 | cut -d' ' -f2)
-  found=$(find "$crashes" -type f | wc -l)
-  echo "fuzz_$t: exit $rc, ${execs:-?} executions, edge coverage ${cov:-?}, features ${ft:-?}, corpus $(ls "$corpus" | wc -l) files, crashes $found (log $log)"
+  found=$(find "$crashes" -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
+  slow=$(find "$crashes" -type f -name 'slow-unit-*' | wc -l)
+  echo "fuzz_$t: exit $rc, ${execs:-?} executions, edge coverage ${cov:-?}, features ${ft:-?}, corpus $(ls "$corpus" | wc -l) files, crashes $found, slow inputs $slow (log $log)"
   if [ "$rc" -ne 0 ] || [ "$found" -ne 0 ]; then status=1; fi
 done
 exit $status
