@@ -1,5 +1,6 @@
 #include "plslam/io/image_loading.h"
 
+#include <cctype>
 #include <fstream>
 #include <iterator>
 #include <vector>
@@ -11,6 +12,38 @@
 #include "plslam/core/error.h"
 
 namespace plslam::io {
+namespace {
+
+// Binary PGM/PPM (P5/P6) store their pixels raw: a header promising more pixels than the file holds
+// is truncated, and OpenCV would first allocate the promised size (a 74-byte file claiming
+// 99999 x 9199 pixels took a gigabyte and 11 s under ASan: found by fuzzing,
+// tests/fuzz/corpus/image/pgm_giant_header_short_file). Returns the problem, or "" when fine.
+std::string raw_pnm_size_problem(const std::vector<uchar>& bytes) {
+  if (bytes.size() < 2 || bytes[0] != 'P' || (bytes[1] != '5' && bytes[1] != '6')) return "";
+  std::size_t i = 2;
+  long long values[3] = {0, 0, 0};
+  for (long long& v : values) {
+    while (i < bytes.size()) {  // whitespace and # comments
+      if (bytes[i] == '#') {
+        while (i < bytes.size() && bytes[i] != '\n') ++i;
+      } else if (std::isspace(bytes[i])) {
+        ++i;
+      } else {
+        break;
+      }
+    }
+    if (i >= bytes.size() || !std::isdigit(bytes[i])) return "malformed PGM/PPM header";
+    while (i < bytes.size() && std::isdigit(bytes[i]) && v < 1000000000) v = v * 10 + (bytes[i++] - '0');
+  }
+  ++i;  // the single whitespace after maxval
+  const long long channels = bytes[1] == '6' ? 3 : 1, depth = values[2] > 255 ? 2 : 1;
+  const long long need = values[0] * values[1] * channels * depth;
+  const long long have = bytes.size() > i ? static_cast<long long>(bytes.size() - i) : 0;
+  if (need > have) return fmt::format("truncated PGM/PPM: the header says {} x {} pixels, the file holds {} bytes of them", values[0], values[1], have);
+  return "";
+}
+
+}  // namespace
 
 cv::Mat load_grey_image(const std::filesystem::path& path) {
   std::error_code ec;
@@ -20,6 +53,7 @@ cv::Mat load_grey_image(const std::filesystem::path& path) {
   const std::vector<uchar> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (bytes.empty()) throw InputError(path.string(), "empty image file");
   // imdecode returns an empty Mat (and libpng may print a warning) for corrupt or truncated data.
+  if (const auto problem = raw_pnm_size_problem(bytes); !problem.empty()) throw InputError(path.string(), problem);
   cv::Mat img;
   try {
     img = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
