@@ -37,8 +37,9 @@ std::string raw_pnm_size_problem(const std::vector<uchar>& bytes) {
   }
   ++i;  // the single whitespace after maxval
   const long long channels = bytes[1] == '6' ? 3 : 1, depth = values[2] > 255 ? 2 : 1;
-  const long long need = values[0] * values[1] * channels * depth;
-  const long long have = bytes.size() > i ? static_cast<long long>(bytes.size() - i) : 0;
+  // In double: each value may be up to ~1e10, their product overflows any integer type (fuzzing).
+  const double need = static_cast<double>(values[0]) * static_cast<double>(values[1]) * static_cast<double>(channels * depth);
+  const double have = bytes.size() > i ? static_cast<double>(bytes.size() - i) : 0.0;
   if (need > have) return fmt::format("truncated PGM/PPM: the header says {} x {} pixels, the file holds {} bytes of them", values[0], values[1], have);
   return "";
 }
