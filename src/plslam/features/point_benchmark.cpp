@@ -18,7 +18,7 @@ namespace {
 
 // Thread CPU time: the machine may be shared, and the stages are single-threaded, so CPU time is
 // the per-core cost without other processes' time slices mixed in.
-struct Clock {
+struct ThreadCpuClock {
   using time_point = double;
   static double now() {
     timespec ts{};
@@ -26,7 +26,7 @@ struct Clock {
     return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
   }
 };
-double ms_since(double t0) { return Clock::now() - t0; }
+double cpu_ms_since(double t0) { return ThreadCpuClock::now() - t0; }
 
 // Level-0 positions of distributed candidates, for the uniformity score.
 std::vector<cv::KeyPoint> to_level0(const PyramidCandidates& kept, const ImagePyramid& pyramid) {
@@ -86,12 +86,12 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
     // The first frame runs twice: the first pass only warms caches and allocations.
     for (int pass = (i == 0 ? 0 : 1); pass < 2; ++pass) {
       PointFeatures left;
-      auto t0 = Clock::now();
+      auto t0 = ThreadCpuClock::now();
       left_extractor.build_pyramid(frame.left, left.pyramid);
-      const double t_pyr = ms_since(t0);
-      t0 = Clock::now();
+      const double t_pyr = cpu_ms_since(t0);
+      t0 = ThreadCpuClock::now();
       const PyramidCandidates cand = left_extractor.detect(left.pyramid);
-      const double t_fast = ms_since(t0);
+      const double t_fast = cpu_ms_since(t0);
       // SSC and quadtree on the same candidates, `distribution_repeats` times each with the order
       // alternating (whichever runs second finds the candidates in cache); the frame's time for
       // each is the median of its repeats, so that one interrupted run does not decide a ratio
@@ -99,14 +99,14 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
       PyramidCandidates ssc, quad;
       std::vector<double> ssc_reps, quad_reps;
       auto run_ssc = [&] {
-        const auto t = Clock::now();
+        const auto t = ThreadCpuClock::now();
         ssc = left_extractor.distribute(cand, Distribution::kSsc);
-        ssc_reps.push_back(ms_since(t));
+        ssc_reps.push_back(cpu_ms_since(t));
       };
       auto run_quadtree = [&] {
-        const auto t = Clock::now();
+        const auto t = ThreadCpuClock::now();
         quad = left_extractor.distribute(cand, Distribution::kQuadtree);
-        quad_reps.push_back(ms_since(t));
+        quad_reps.push_back(cpu_ms_since(t));
       };
       const int repeats = std::max(1, options.distribution_repeats);
       for (int r = 0; r < repeats; ++r) {
@@ -119,15 +119,15 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
         }
       }
       const double t_ssc = percentile(ssc_reps, 0.5), t_quad = percentile(quad_reps, 0.5);
-      t0 = Clock::now();
+      t0 = ThreadCpuClock::now();
       left_extractor.describe(left.pyramid, ssc, left);
-      const double t_orb = ms_since(t0);
-      t0 = Clock::now();
+      const double t_orb = cpu_ms_since(t0);
+      t0 = ThreadCpuClock::now();
       const PointFeatures right = right_extractor.extract(frame.right);
-      const double t_right = ms_since(t0);
-      t0 = Clock::now();
+      const double t_right = cpu_ms_since(t0);
+      t0 = ThreadCpuClock::now();
       const matching::StereoPointMatches m = matching::match_stereo_points(left, right, stereo);
-      const double t_stereo = ms_since(t0);
+      const double t_stereo = cpu_ms_since(t0);
       if (pass == 0) continue;
       pyramid_ms.push_back(t_pyr);
       fast_ms.push_back(t_fast);
