@@ -4,8 +4,10 @@
 #include <exception>
 #include <iostream>
 #include <map>
+#include <string_view>
 
 #include "command_registry.h"
+#include "json_stdout.h"
 #include "plslam/core/error.h"
 #include "plslam/core/log.h"
 #include "plslam/core/version.h"
@@ -36,6 +38,9 @@ int main(int argc, char** argv) {
 
   plslam::init_logging(verbose ? plslam::LogLevel::kDebug : plslam::LogLevel::kInfo);
   try {
+    if (std::any_of(argv + 1, argv + argc, [](const char* a) { return std::string_view(a) == "--json"; })) {
+      plslam::cli::reserve_stdout_for_json();
+    }
     for (auto* sub : app.get_subcommands()) return actions.at(sub)();
     return 2;
   } catch (const plslam::InputError& e) {

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command_registry.h"
+#include "json_stdout.h"
 #include "commands/dataset_options.h"
 #include "plslam/core/error.h"
 #include "plslam/core/sample_stats.h"
@@ -71,7 +72,7 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   j.update(features::benchmark_lines(*ds, 0, lo));
   j["frame_ms"] = frame_benchmark(*ds, kitti);
   if (args.json) {
-    std::cout << j.dump(2) << "\n";
+    print_json(j.dump(2) + "\n");
     return 0;
   }
   std::cout << fmt::format("{} ({}), {} frames, {}x{}, {} features, FAST {}, one thread\n", j["dataset"].get<std::string>(),
@@ -109,16 +110,10 @@ CommandRegistration reg({"bench", "Benchmark front-end stages on real frames", [
                            sub.require_subcommand(1);
                            auto args = std::make_shared<BenchFeaturesArgs>();
                            CLI::App* features = sub.add_subcommand("features", "Point and line features: per-stage ms, counts, uniformity, whole-frame ms");
-                           features->add_option("dataset", args->dataset.path, "KITTI sequences/NN or EuRoC <seq>[/mav0]")->required();
-                           features->add_option("--format", args->dataset.format, "Dataset format")
-                               ->check(CLI::IsMember({"auto", "kitti", "euroc"}))
-                               ->capture_default_str();
-                           features->add_option("--start", args->dataset.start, "First frame")->capture_default_str();
-                           features->add_option("--frames,--max-frames", args->dataset.max_frames, "At most this many frames (-1: all)")
-                               ->capture_default_str();
+                           add_dataset_options(*features, args->dataset, "--frames,--max-frames");
                            features->add_flag("--json", args->json, "Print a JSON object");
                            features->add_option("--features", args->n_features, "Keypoints per image (0: 1200 EuRoC, 2000 KITTI)")
-                               ->check(CLI::NonNegativeNumber)->capture_default_str();
+                               ->check(CLI::Range(0, 100000))->capture_default_str();
                            features->add_option("--fast-threshold", args->fast_threshold, "FAST threshold (single mode)")
                                ->check(CLI::Range(1, 254))->capture_default_str();
                            features->add_option("--fast-mode", args->fast_mode, "single | ini_min (20/7 per cell)")
@@ -126,7 +121,7 @@ CommandRegistration reg({"bench", "Benchmark front-end stages on real frames", [
                            features->add_option("--fast-impl", args->fast_impl, "FAST code: auto | avx2 | sse2 | scalar | opencv (same corners)")
                                ->check(CLI::IsMember({"auto", "avx2", "sse2", "scalar", "opencv"}))->capture_default_str();
                            features->add_option("--right-factor", args->right_factor, "Right image keeps this many times more points")
-                               ->capture_default_str();
+                               ->check(CLI::Range(0.1, 100.0))->capture_default_str();
                            return std::function<int()>([args, features] {
                              if (features->parsed()) return run_bench_features(*args);
                              return 2;

@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command_registry.h"
+#include "json_stdout.h"
 #include "plslam/core/error.h"
 #include "plslam/io/euroc_sensor.h"
 #include "plslam/eval/evaluate.h"
@@ -94,7 +95,7 @@ int run(const Options& o) {
     }
   }
   if (o.json) {
-    std::cout << plslam::eval::to_json(result).dump(2) << "\n";
+    plslam::cli::print_json(plslam::eval::to_json(result).dump(2) + "\n");
   } else {
     std::cout << plslam::eval::format_report(result);
   }

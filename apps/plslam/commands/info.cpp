@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command_registry.h"
+#include "json_stdout.h"
 #include "commands/dataset_options.h"
 
 namespace plslam::cli {
@@ -35,7 +36,7 @@ int run_info(const InfoArgs& args) {
                         {"duration_s", duration},
                         {"has_ground_truth", ds->ground_truth().has_value()},
                         {"gt_path_length_m", ds->ground_truth_length()}};
-    std::cout << j.dump(2) << "\n";
+    print_json(j.dump(2) + "\n");
     return 0;
   }
   std::cout << fmt::format("dataset      {}\n", ds->root().string())

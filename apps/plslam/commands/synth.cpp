@@ -1,5 +1,8 @@
 // `plslam synth`: render a synthetic stereo sequence with exact ground truth.
+#include <unistd.h>
+
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -8,7 +11,9 @@
 #include "command_registry.h"
 #include "plslam/core/error.h"
 #include "plslam/core/log.h"
+#include "plslam/io/output_folder.h"
 #include "plslam/synth/writer.h"
+#include "stop_signals.h"
 
 namespace {
 
@@ -21,8 +26,71 @@ struct Options {
   std::uint64_t seed = 1;
   bool loop = false;
   bool motion_blur = false;
+  bool force = false;
   int threads = 0;
 };
+
+namespace fs = std::filesystem;
+
+// The dataset is rendered into a hidden folder beside --out and moved into place when complete, so
+// a folder under the requested name is always a whole dataset; an interrupted or failed run
+// removes the staging folder.
+class StagingFolder {
+ public:
+  explicit StagingFolder(const fs::path& out)
+      : path_(out.parent_path() / fmt::format(".{}.synth-{}", out.filename().string(), ::getpid())) {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+    plslam::io::prepare_output_folder(path_);
+  }
+  StagingFolder(const StagingFolder&) = delete;
+  StagingFolder& operator=(const StagingFolder&) = delete;
+  ~StagingFolder() {
+    std::error_code ec;
+    if (!committed_) fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+  // Moves the staging folder to `out`; an existing `out` (allowed by --force) is replaced whole.
+  void commit(const fs::path& out) {
+    std::error_code ec;
+    if (fs::exists(out)) {
+      const fs::path old = out.parent_path() / fmt::format(".{}.replaced-{}", out.filename().string(), ::getpid());
+      fs::rename(out, old, ec);
+      if (ec) throw plslam::InputError(out.string(), "cannot move the old folder aside: " + ec.message());
+      fs::rename(path_, out, ec);
+      if (ec) {
+        fs::rename(old, out);
+        throw plslam::InputError(out.string(), "cannot move the new dataset into place: " + ec.message());
+      }
+      fs::remove_all(old, ec);
+    } else {
+      fs::rename(path_, out, ec);
+      if (ec) throw plslam::InputError(out.string(), "cannot move the new dataset into place: " + ec.message());
+    }
+    committed_ = true;
+  }
+
+ private:
+  fs::path path_;
+  bool committed_ = false;
+};
+
+// --out must be absent or an empty folder unless --force: stale files of an older dataset would
+// mix with the new one.
+fs::path checked_out_folder(const std::string& given, bool force) {
+  if (given.empty()) throw plslam::InputError("--out", "empty output folder name");
+  fs::path out = fs::absolute(given).lexically_normal();
+  if (out.filename().empty()) out = out.parent_path();
+  std::error_code ec;
+  if (fs::exists(out, ec)) {
+    if (!fs::is_directory(out, ec)) throw plslam::InputError(out.string(), "is a file, expected an output folder");
+    if (!force && !fs::is_empty(out, ec)) {
+      throw plslam::InputError(out.string(), "folder is not empty (give --force to replace it)");
+    }
+  }
+  return out;
+}
 
 int run(const Options& o) {
   plslam::synth::SequenceOptions so;
@@ -33,23 +101,33 @@ int run(const Options& o) {
   so.loop = o.loop;
   so.motion_blur = o.motion_blur;
   const auto format = plslam::synth::parse_output_format(o.format.empty() ? o.preset : o.format);
-  const plslam::synth::Sequence seq(so);
+  const plslam::synth::Sequence seq(so);  // checks the options first: they are the likelier mistake
+  const fs::path out = checked_out_folder(o.out, o.force);
+  plslam::app::install_stop_signals();
   spdlog::info("synth: {} scene, {} preset ({}x{} @ {} Hz, baseline {} m), {} frames, path {:.1f} m at {:.2f} m/s{}",
                o.scene, so.preset.name, so.preset.width, so.preset.height, so.preset.fps, so.preset.baseline,
                o.frames, seq.path().length(), seq.path().speed(), o.loop ? ", loop" : "");
   const auto start = std::chrono::steady_clock::now();
   std::size_t last = 0;
-  plslam::synth::write_sequence(
-      seq, o.out, format,
+  StagingFolder staging(out);
+  const bool complete = plslam::synth::write_sequence(
+      seq, staging.path(), format,
       [&](std::size_t done, std::size_t total) {
         if (done == total || done >= last + std::max<std::size_t>(1, total / 10)) {
           last = done;
-          spdlog::info("synth: {}/{} frames", done, total);
+          const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          const double eta = elapsed / static_cast<double>(done) * static_cast<double>(total - done);
+          spdlog::info("synth: {}/{} frames, ETA {:.0f} s", done, total, eta);
         }
       },
-      o.threads);
+      o.threads, [] { return plslam::app::stop_requested(); });
+  if (!complete || plslam::app::stop_requested()) {
+    spdlog::warn("synth: stopped by {}; nothing written to {}", plslam::app::stop_signal_name(), out.string());
+    return plslam::app::stop_exit_code();
+  }
+  staging.commit(out);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  spdlog::info("synth: wrote {} in {:.1f} s", o.out, s);
+  spdlog::info("synth: wrote {} in {:.1f} s", out.string(), s);
   return 0;
 }
 
@@ -66,10 +144,13 @@ plslam::cli::CommandRegistration reg({"synth", "Render a synthetic stereo sequen
                                         sub.add_option("--preset", o->preset, "Camera preset: euroc|kitti")
                                             ->capture_default_str();
                                         sub.add_option("--seed", o->seed, "Seed for textures and motion")
+                                            ->check(CLI::NonNegativeNumber)
                                             ->capture_default_str();
                                         sub.add_flag("--loop", o->loop, "Close a loop of >= 30 m and return to the start");
                                         sub.add_flag("--motion-blur", o->motion_blur, "Blur proportional to the motion");
+                                        sub.add_flag("--force", o->force, "Replace a non-empty --out folder");
                                         sub.add_option("--threads", o->threads, "Rendering threads (0: all cores)")
+                                            ->check(CLI::Range(0, 1024))
                                             ->capture_default_str();
                                         return std::function<int()>([o] { return run(*o); });
                                       }});

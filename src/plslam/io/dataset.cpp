@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -51,12 +52,38 @@ bool looks_like_kitti(const fs::path& p) {
   return fs::exists(p / "calib.txt") || fs::is_directory(p / "image_0");
 }
 
+// A KITTI odometry root (sequences/NN plus poses/, as `plslam synth --format kitti` writes it)
+// holding exactly one sequence stands for that sequence; with several, the user must choose.
+fs::path single_kitti_sequence(const fs::path& root) {
+  std::vector<fs::path> found;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(root / "sequences", ec)) {
+    if (e.is_directory() && looks_like_kitti(e.path())) found.push_back(e.path());
+  }
+  std::sort(found.begin(), found.end());
+  if (found.empty()) {
+    throw InputError((root / "sequences").string(), "no KITTI sequence (NN/ with calib.txt and image_0/) inside");
+  }
+  if (found.size() > 1) {
+    throw InputError(root.string(), fmt::format("holds {} KITTI sequences; name one, e.g. {}", found.size(),
+                                                found.front().string()));
+  }
+  return found.front();
+}
+
 }  // namespace
 
-std::unique_ptr<Dataset> open_dataset(const fs::path& path, const DatasetOptions& options) {
+std::unique_ptr<Dataset> open_dataset(const fs::path& given, const DatasetOptions& options) {
   std::error_code ec;
-  if (!fs::exists(path, ec)) throw InputError(path.string(), "no such folder");
-  if (!fs::is_directory(path, ec)) throw InputError(path.string(), "not a folder");
+  if (!fs::exists(given, ec)) throw InputError(given.string(), "no such folder");
+  if (!fs::is_directory(given, ec)) throw InputError(given.string(), "not a folder");
+  // "mav0/" and "sequences/06/" name the same folders as without the slash.
+  fs::path path = given.lexically_normal();
+  if (path.filename().empty() && path.has_parent_path()) path = path.parent_path();
+  if (!looks_like_kitti(path) && !fs::is_directory(path / "mav0") && path.filename() != "mav0" &&
+      fs::is_directory(path / "sequences") && options.format != DatasetFormat::kEuroc) {
+    path = single_kitti_sequence(path);
+  }
   fs::path mav0;
   if (path.filename() == "mav0") {
     mav0 = path;
@@ -110,7 +137,8 @@ void validate_calibration(const StereoCalibration& c, const fs::path& file) {
   }
   if (c.fx <= 0 || c.fy <= 0) throw InputError(file.string(), "focal length must be positive");
   if (!(c.baseline > 0)) {
-    throw InputError(file.string(), fmt::format("baseline must be positive, got {} m", c.baseline));
+    // + 0.0 turns -0 (from -(0 / fx)) into 0, which is what the user wrote.
+    throw InputError(file.string(), fmt::format("baseline must be positive, got {} m", c.baseline + 0.0));
   }
 }
 

@@ -17,6 +17,7 @@
 #include "plslam/io/dataset_impl.h"
 #include "plslam/io/euroc_sensor.h"
 #include "plslam/io/image_loading.h"
+#include "plslam/io/text_table.h"
 #include "plslam/io/trajectory_io.h"
 
 namespace plslam::io::detail {
@@ -30,15 +31,13 @@ struct ImageEntry {
 };
 
 std::vector<ImageEntry> read_image_list(const fs::path& csv) {
-  if (!fs::exists(csv)) throw InputError(csv.string(), "file not found");
-  std::ifstream in(csv);
-  if (!in) throw InputError(csv.string(), "cannot open file");
+  std::ifstream in = open_text_file(csv);
   std::vector<ImageEntry> entries;
   std::string line;
   std::size_t line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+    strip_cr(line);
     if (line.empty() || line[0] == '#') continue;
     const auto comma = line.find(',');
     if (comma == std::string::npos) {
@@ -129,6 +128,12 @@ class EurocDataset final : public Dataset {
   void compute_rectification(const EurocCameraSensor& cam1, const fs::path& yaml1) {
     // p_c1 = T_BS1^-1 * T_BS0 * p_c0: the pose of cam0 in cam1's frame, as stereoRectify wants.
     const Eigen::Isometry3d T_c1_c0 = cam1.T_BS.inverse() * cam0_.T_BS;
+    // Two cameras at one place give no depth (stereoRectify would assert); say so in plain words.
+    const double baseline = T_c1_c0.translation().norm();
+    if (!(baseline > 1e-6)) {
+      throw InputError(yaml1.string(), fmt::format("baseline must be positive, got {} m: T_BS places cam1 where "
+                                                   "cam0 is", baseline));
+    }
     cv::Mat R, T;
     cv::eigen2cv(Eigen::Matrix3d(T_c1_c0.rotation()), R);
     cv::eigen2cv(Eigen::Vector3d(T_c1_c0.translation()), T);

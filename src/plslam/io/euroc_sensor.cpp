@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "plslam/core/error.h"
+#include "plslam/io/text_table.h"
 
 namespace plslam::io {
 namespace {
@@ -16,13 +17,12 @@ namespace fs = std::filesystem;
 
 // ASL files start with OpenCV's "%YAML:1.0" directive, which is not valid YAML 1.2: drop it.
 YAML::Node load_yaml(const fs::path& path) {
-  if (!fs::exists(path)) throw InputError(path.string(), "file not found");
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), "cannot open file");
+  std::ifstream in = open_text_file(path);
   std::stringstream ss;
   std::string line;
   bool first = true;
   while (std::getline(in, line)) {
+    strip_cr(line);
     if (first && line.rfind("%YAML", 0) == 0) {
       first = false;
       continue;

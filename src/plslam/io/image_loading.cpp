@@ -48,6 +48,7 @@ std::string raw_pnm_size_problem(const std::vector<uchar>& bytes) {
 
 cv::Mat load_grey_image(const std::filesystem::path& path) {
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path.string(), "is a folder, expected an image file");
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path.string(), "image file not found");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string(), "cannot open image");

@@ -1,6 +1,7 @@
 // KITTI odometry: sequences/NN/{calib.txt, times.txt, image_0/, image_1/}, ground truth in
 // ../../poses/NN.txt. Images are already rectified; P1's fourth entry is -fx * baseline.
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -22,15 +23,14 @@ using Projection = std::array<double, 12>;
 
 // Reads labelled lines ("P0: ..."); a file of bare 12-number lines is read as P0, P1 in order.
 std::map<std::string, Projection> read_calib(const fs::path& path) {
-  if (!fs::exists(path)) throw InputError(path.string(), "calibration file not found");
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), "cannot open calibration file");
+  std::ifstream in = open_text_file(path, "calibration file not found");
   std::map<std::string, Projection> result;
   std::string line;
   std::size_t line_no = 0, unlabelled = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    strip_cr(line);
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
     std::string label;
     const auto colon = line.find(':');
     if (colon != std::string::npos) {
@@ -80,11 +80,22 @@ StereoCalibration calibration_from(const std::map<std::string, Projection>& P, c
   return c;
 }
 
-std::vector<std::string> list_pngs(const fs::path& dir) {
-  if (!fs::is_directory(dir)) throw InputError(dir.string(), "image folder not found");
+bool is_image_name(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".pgm" || ext == ".ppm" || ext == ".bmp" ||
+         ext == ".tif" || ext == ".tiff";
+}
+
+// The image files of one camera (PNG as KITTI ships them, or JPEG, PGM, PPM, BMP, TIFF), by name.
+std::vector<std::string> list_images(const fs::path& dir) {
+  if (!fs::exists(dir)) throw InputError(dir.string(), "image folder not found");
+  if (!fs::is_directory(dir)) throw InputError(dir.string(), "is a file, expected the image folder");
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.is_regular_file() && e.path().extension() == ".png") names.push_back(e.path().filename().string());
+    if (!is_image_name(e.path())) continue;
+    if (e.is_directory()) throw InputError(e.path().string(), "is a folder, expected an image file");
+    if (e.is_regular_file()) names.push_back(e.path().filename().string());
   }
   std::sort(names.begin(), names.end());
   return names;
@@ -97,8 +108,8 @@ class KittiDataset final : public Dataset {
     const auto calib_path = root / "calib.txt";
     calib_ = calibration_from(read_calib(calib_path), calib_path);
 
-    auto left = list_pngs(root / "image_0");
-    const auto right = list_pngs(root / "image_1");
+    auto left = list_images(root / "image_0");
+    const auto right = list_images(root / "image_1");
     if (left.empty()) throw InputError((root / "image_0").string(), "empty image folder");
     if (right.empty()) throw InputError((root / "image_1").string(), "empty image folder");
     const std::size_t all_left = left.size();
@@ -173,9 +184,18 @@ class KittiDataset final : public Dataset {
  private:
   void load_ground_truth(const std::vector<double>& times, const std::vector<std::size_t>& original_index,
                          std::size_t start, std::size_t count) {
-    const auto seq = root_.filename().string();
-    const auto poses = root_.parent_path().parent_path() / "poses" / (seq + ".txt");
-    if (!fs::exists(poses)) return;
+    // poses/NN.txt beside sequences/; a sequence folder reached through a symlink finds it beside
+    // the folder the link points to.
+    const auto beside = [](const fs::path& seq) {
+      return seq.parent_path().parent_path() / "poses" / (seq.filename().string() + ".txt");
+    };
+    auto poses = beside(root_);
+    std::error_code ec;
+    if (!fs::exists(poses)) {
+      const auto real = fs::canonical(root_, ec);
+      if (ec || !fs::exists(beside(real))) return;
+      poses = beside(real);
+    }
     const auto all = read_trajectory(poses, TrajectoryFormat::kKitti);
     Trajectory gt;
     for (std::size_t i = start; i < start + count; ++i) {

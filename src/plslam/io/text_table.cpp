@@ -22,16 +22,34 @@ double parse_finite(const std::string& field, const std::filesystem::path& path,
   return v;
 }
 
+std::ifstream open_text_file(const std::filesystem::path& path, const char* missing) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) throw InputError(path.string(), missing);
+  if (std::filesystem::is_directory(status)) throw InputError(path.string(), "is a folder, expected a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string(), "cannot open file (permission denied?)");
+  char bom[3] = {};
+  in.read(bom, 3);
+  if (!(in.gcount() == 3 && bom[0] == '\xEF' && bom[1] == '\xBB' && bom[2] == '\xBF')) {
+    in.clear();
+    in.seekg(0);
+  }
+  return in;
+}
+
+void strip_cr(std::string& line) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+}
+
 std::vector<NumericRow> read_numeric_rows(const std::filesystem::path& path) {
-  if (!std::filesystem::exists(path)) throw InputError(path.string(), "file not found");
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), "cannot open file");
+  std::ifstream in = open_text_file(path);
   std::vector<NumericRow> rows;
   std::string text;
   std::size_t line_no = 0;
   while (std::getline(in, text)) {
     ++line_no;
-    if (!text.empty() && text.back() == '\r') text.pop_back();
+    strip_cr(text);
     const auto first = text.find_first_not_of(" \t");
     if (first == std::string::npos || text[first] == '#') continue;
     NumericRow row;

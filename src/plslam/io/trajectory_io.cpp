@@ -88,10 +88,10 @@ TrajectoryFormat detect_trajectory_format(const std::filesystem::path& path) {
   if (ext == ".csv") return TrajectoryFormat::kEuroc;
   if (ext == ".kitti") return TrajectoryFormat::kKitti;
   if (ext == ".tum") return TrajectoryFormat::kTum;
-  if (!std::filesystem::exists(path)) throw InputError(path.string(), "file not found");
-  std::ifstream in(path);
+  std::ifstream in = open_text_file(path);
   std::string line;
   while (std::getline(in, line)) {
+    strip_cr(line);
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos || line[first] == '#') continue;
     if (line.find(',') != std::string::npos) return TrajectoryFormat::kEuroc;

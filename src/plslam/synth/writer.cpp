@@ -1,6 +1,7 @@
 #include "plslam/synth/writer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <fstream>
 #include <mutex>
 
@@ -112,17 +113,23 @@ void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const E
   open_out(dir / "synth.json") << j.dump(2) << "\n";
 }
 
-void render_all(const Sequence& seq, const Progress& progress, int threads,
+// False when `cancelled` stopped it before every frame was written.
+bool render_all(const Sequence& seq, const Progress& progress, int threads, const Cancelled& cancelled,
                 const std::function<void(std::size_t, const StereoImages&)>& sink) {
   const std::size_t n = seq.size();
   std::size_t done = 0;
   std::mutex mu;
+  std::atomic<bool> stopped{false};
   // Chunks of 8 frames, each with its own renderer (it keeps per-thread scratch images).
   constexpr std::size_t kChunk = 8;
   auto body = [&](int c) {
     StereoRenderer renderer(seq);
     const std::size_t begin = static_cast<std::size_t>(c) * kChunk, end = std::min(n, begin + kChunk);
     for (std::size_t i = begin; i < end; ++i) {
+      if (stopped.load() || (cancelled && cancelled())) {
+        stopped.store(true);
+        return;
+      }
       sink(i, renderer.render(i));
       std::lock_guard<std::mutex> lock(mu);
       ++done;
@@ -132,15 +139,16 @@ void render_all(const Sequence& seq, const Progress& progress, int threads,
   const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
   if (threads == 1) {
     for (int c = 0; c < chunks; ++c) body(c);
-    return;
+  } else {
+    core::WorkerPool(threads).run(chunks, body);
   }
-  core::WorkerPool(threads).run(chunks, body);
+  return !stopped.load();
 }
 
 }  // namespace
 
-void write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat format, const Progress& progress,
-                    int threads) {
+bool write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat format, const Progress& progress,
+                    int threads, const Cancelled& cancelled) {
   const std::size_t n = seq.size();
   if (format == OutputFormat::kEuroc) {
     const fs::path mav = dir / "mav0";
@@ -163,14 +171,15 @@ void write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat forma
       body.push_back({t, seq.left_pose(i) * T_BS0.inverse()});  // T_wb = T_wc * T_cb
     }
     io::write_trajectory(mav / "state_groundtruth_estimate0" / "data.csv", body, io::TrajectoryFormat::kEuroc);
-    render_all(seq, progress, threads, [&](std::size_t i, const StereoImages& im) {
+    const bool complete = render_all(seq, progress, threads, cancelled, [&](std::size_t i, const StereoImages& im) {
       const std::string name = fmt::format("{}.png", euroc_timestamp_ns(seq, i));
       write_png(mav / "cam0" / "data" / name, im.left);
       write_png(mav / "cam1" / "data" / name, im.right);
     });
+    if (!complete) return false;
     // Last, so that synth/synth.json marks a complete sequence.
     write_ground_truth_extras(seq, mav / "synth", Eigen::Isometry3d::Identity(), times, "euroc world (z up)");
-    return;
+    return true;
   }
   const fs::path sdir = dir / "sequences" / "00";
   fs::create_directories(sdir / "image_0");
@@ -197,11 +206,13 @@ void write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat forma
   for (std::size_t i = 0; i < n; ++i) poses.push_back({times[i], T_0w * seq.left_pose(i)});
   poses[0].T = Eigen::Isometry3d::Identity();  // exactly, not up to rounding
   io::write_trajectory(dir / "poses" / "00.txt", poses, io::TrajectoryFormat::kKitti);
-  render_all(seq, progress, threads, [&](std::size_t i, const StereoImages& im) {
+  const bool complete = render_all(seq, progress, threads, cancelled, [&](std::size_t i, const StereoImages& im) {
     write_png(sdir / "image_0" / fmt::format("{:06d}.png", i), im.left);
     write_png(sdir / "image_1" / fmt::format("{:06d}.png", i), im.right);
   });
+  if (!complete) return false;
   write_ground_truth_extras(seq, sdir / "synth", T_0w, times, "kitti first left camera");
+  return true;
 }
 
 }  // namespace plslam::synth

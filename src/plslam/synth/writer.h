@@ -37,8 +37,12 @@ std::int64_t euroc_timestamp_ns(const Sequence& seq, std::size_t i);
 // Called after each frame is written with (frames done, total).
 using Progress = std::function<void(std::size_t, std::size_t)>;
 
-// Renders every frame (in parallel when `threads` != 1) and writes the dataset.
-void write_sequence(const Sequence& seq, const std::filesystem::path& dir, OutputFormat format,
-                    const Progress& progress = {}, int threads = 0);
+// Polled before each frame; true stops the rendering (a signal asked the program to stop).
+using Cancelled = std::function<bool()>;
+
+// Renders every frame (in parallel when `threads` != 1) and writes the dataset into `dir`.
+// Returns false, with the dataset incomplete, when `cancelled` stopped it.
+bool write_sequence(const Sequence& seq, const std::filesystem::path& dir, OutputFormat format,
+                    const Progress& progress = {}, int threads = 0, const Cancelled& cancelled = {});
 
 }  // namespace plslam::synth
