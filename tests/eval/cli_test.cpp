@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -60,7 +61,9 @@ TEST(EvalCli, JsonHasExactlyTheDocumentedKeys) {
   const auto j = nlohmann::json::parse(r.out);
   std::vector<std::string> keys;
   for (const auto& [k, v] : j.items()) keys.push_back(k);
-  EXPECT_EQ(keys, (std::vector<std::string>{"ape_trans_m", "pairs", "rpe_rot_deg", "rpe_trans_m"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"alignment", "ape_trans_m", "coverage", "pairs", "rpe_rot_deg", "rpe_trans_m"}));
+  EXPECT_EQ(j["alignment"], "se3");
+  EXPECT_NEAR(j["coverage"].get<double>(), 1.0, 0.01);
   EXPECT_EQ(j["pairs"].get<int>(), 300);
   for (const char* k : {"ape_trans_m", "rpe_trans_m", "rpe_rot_deg"}) {
     std::vector<std::string> names;
@@ -217,6 +220,79 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"kitti_mismatched_lengths", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n1 0 0 2 0 1 0 0 0 0 1 0\n1 0 0 3 0 1 0 0 0 0 1 1\n",
                  "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n1 0 0 2 0 1 0 0 0 0 1 0\n", "4 poses and the estimate 3"}),
     [](const auto& info) { return std::string(info.param.name); });
+
+// An estimate that covers little of the ground truth would score well for the wrong reason: eval
+// says how much it covers, refuses under 20 % or 10 pairs, and --allow-partial scores it anyway.
+TEST(EvalCli, CoverageIsReportedAndAShortEstimateRefusedUnlessAllowed) {
+  plslam::test::TempDir dir;
+  const Trajectory g = test::helix(300);
+  io::write_trajectory(dir.path() / "gt.tum", g, TrajectoryFormat::kTum);
+  io::write_trajectory(dir.path() / "half.tum", Trajectory(g.begin(), g.begin() + 151), TrajectoryFormat::kTum);
+  io::write_trajectory(dir.path() / "short.tum", Trajectory(g.begin() + 100, g.begin() + 130), TrajectoryFormat::kTum);
+  const std::string gt = " --gt " + q(dir.path() / "gt.tum");
+
+  const auto half = run_cli("eval --json" + gt + " --est " + q(dir.path() / "half.tum"));
+  ASSERT_EQ(half.exit_code, 0) << half.err;
+  EXPECT_NEAR(nlohmann::json::parse(half.out)["coverage"].get<double>(), 150.0 / 299.0, 1e-9);
+  EXPECT_NE(run_cli("eval" + gt + " --est " + q(dir.path() / "half.tum")).out.find("coverage       50.2 %"),
+            std::string::npos);
+
+  const auto refused = run_cli("eval" + gt + " --est " + q(dir.path() / "short.tum"));
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_EQ(count_lines(refused.err), 1) << refused.err;
+  EXPECT_NE(refused.err.find("covers 10 % of the ground truth with 30 pose pairs"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("--allow-partial"), std::string::npos) << refused.err;
+  EXPECT_TRUE(refused.out.empty());
+
+  const auto allowed = run_cli("eval --json --allow-partial" + gt + " --est " + q(dir.path() / "short.tum"));
+  ASSERT_EQ(allowed.exit_code, 0) << allowed.err;
+  EXPECT_EQ(nlohmann::json::parse(allowed.out)["pairs"].get<int>(), 30);
+}
+
+// A failed start writes identity poses; degenerate ground truth stands still. Aligning either
+// would report an excellent error (or a Sim(3) scale of 0): refused unless --allow-degenerate,
+// which scores without alignment and says so.
+TEST(EvalCli, DegenerateAlignmentIsRefusedUnlessAllowed) {
+  plslam::test::TempDir dir;
+  const Trajectory g = test::helix(100);
+  Trajectory still = g;
+  for (auto& p : still) p.T = Eigen::Isometry3d::Identity();
+  io::write_trajectory(dir.path() / "gt.tum", g, TrajectoryFormat::kTum);
+  io::write_trajectory(dir.path() / "still.tum", still, TrajectoryFormat::kTum);
+  const std::string gt = q(dir.path() / "gt.tum"), st = q(dir.path() / "still.tum");
+  for (const char* align : {"se3", "sim3"}) {
+    const auto est_still = run_cli(fmt::format("eval --align {} --gt {} --est {}", align, gt, st));
+    EXPECT_EQ(est_still.exit_code, 2) << align;
+    EXPECT_NE(est_still.err.find("degenerate alignment: the paired estimated positions all coincide"),
+              std::string::npos) << est_still.err;
+    const auto gt_still = run_cli(fmt::format("eval --align {} --gt {} --est {}", align, st, gt));
+    EXPECT_EQ(gt_still.exit_code, 2) << align;
+    EXPECT_NE(gt_still.err.find("ground-truth positions all coincide"), std::string::npos) << gt_still.err;
+  }
+  const auto allowed = run_cli(fmt::format("eval --json --align sim3 --allow-degenerate --gt {} --est {}", gt, st));
+  ASSERT_EQ(allowed.exit_code, 0) << allowed.err;
+  const auto j = nlohmann::json::parse(allowed.out);
+  EXPECT_EQ(j["alignment"], "none");
+  EXPECT_NE(j["degenerate"].get<std::string>().find("coincide"), std::string::npos);
+  EXPECT_GT(j["ape_trans_m"]["max"].get<double>(), 0.5);  // the unaligned error, not a perfect score
+  // --align none never aligns, so nothing is degenerate.
+  EXPECT_EQ(run_cli(fmt::format("eval --align none --gt {} --est {}", gt, st)).exit_code, 0);
+}
+
+// Plots are written whole or not at all: a write that fails leaves no file under its name.
+TEST(EvalCli, AFailedPlotWriteLeavesNoFileAndFails) {
+  Files f;
+  const auto dir = f.dir.path() / "plots";
+  ::setenv("PLSLAM_FAIL_WRITE", "ape.png", 1);
+  const auto failed = run_cli("eval --gt " + q(f.gt) + " --est " + q(f.est) + " --plot " + q(dir));
+  ::unsetenv("PLSLAM_FAIL_WRITE");
+  EXPECT_NE(failed.exit_code, 0);
+  EXPECT_NE(failed.err.find("ape.png"), std::string::npos) << failed.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "ape.png"));
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+  }
+}
 
 TEST(EvalCli, BadOptionsExit2) {
   Files f;

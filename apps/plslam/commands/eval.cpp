@@ -30,7 +30,15 @@ struct Options {
   bool json = false;
   std::string plot_dir;
   std::string frames;  // frames.csv of the run, for tracking.png
+  bool allow_partial = false;
+  bool allow_degenerate = false;
 };
+
+// An estimate is scored only when it pairs with at least this share of the ground truth, in at
+// least this many poses: a run that lost track after a few frames would otherwise report an
+// excellent error over the few poses it has. An interrupted run's half trajectory still scores.
+constexpr double kMinCoverage = 0.2;
+constexpr std::size_t kMinPairs = 10;
 
 plslam::io::TrajectoryFormat resolve_format(const std::string& name, const std::string& path) {
   if (name == "auto") return plslam::io::detect_trajectory_format(path);
@@ -57,6 +65,11 @@ int run(const Options& o) {
   options.rpe.unit = o.rpe_unit == "m" ? plslam::eval::DeltaUnit::kMeters : plslam::eval::DeltaUnit::kFrames;
   options.rpe.all_pairs = o.all_pairs;
   options.kitti_metric = o.kitti_metric;
+  if (!o.allow_partial) {
+    options.min_coverage = kMinCoverage;
+    options.min_pairs = kMinPairs;
+  }
+  options.allow_degenerate = o.allow_degenerate;
 
   // KITTI files carry no times: such a pair is matched pose by pose. When only one side is KITTI
   // the other's stamps cannot be matched against anything, so index pairing needs equal lengths,
@@ -79,9 +92,11 @@ int run(const Options& o) {
   }
 
   const auto result = plslam::eval::evaluate(gt, est, options);
-  spdlog::info("matched {} pose pairs {} ({} ground-truth poses, {} estimated)", result.pairs.size(),
+  spdlog::info("matched {} pose pairs {} ({} ground-truth poses, {} estimated): the estimate covers {:.1f} % of "
+               "the ground truth", result.pairs.size(),
                options.pair_by_index ? "by index" : fmt::format("by timestamp (max diff {} s)", o.t_max_diff),
-               gt.size(), est.size());
+               gt.size(), est.size(), 100.0 * result.coverage);
+  if (!result.degenerate.empty()) spdlog::warn("degenerate alignment ({}): scored without alignment", result.degenerate);
 
   if (!o.plot_dir.empty()) {
     plslam::eval::PlotOptions plot_options;
@@ -126,6 +141,10 @@ plslam::cli::CommandRegistration reg({"eval", "Evaluate an estimated trajectory 
     sub.add_flag("--all-pairs", o->all_pairs, "RPE over all pairs instead of consecutive ones");
     sub.add_flag("--kitti-metric", o->kitti_metric, "Also compute the KITTI odometry metric");
     sub.add_flag("--json", o->json, "Print the results as JSON on stdout");
+    sub.add_flag("--allow-partial", o->allow_partial,
+                 "Score an estimate covering under 20 % of the ground truth, or with under 10 pose pairs");
+    sub.add_flag("--allow-degenerate", o->allow_degenerate,
+                 "Score, unaligned, an estimate or ground truth whose positions all coincide, or a collapsing Sim(3)");
     sub.add_option("--plot", o->plot_dir, "Write trajectory.png, ape.png and rpe.png into DIR");
     sub.add_option("--frames", o->frames,
                    "With --plot: the run's frames.csv, plotted in tracking.png next to the APE (inliers, keyframes, local map)");

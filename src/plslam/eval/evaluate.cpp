@@ -1,5 +1,7 @@
 #include "plslam/eval/evaluate.h"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "plslam/core/error.h"
@@ -21,6 +23,32 @@ std::string stats_line(const char* name, const char* unit, const ErrorStatistics
   return fmt::format("{:<14} rmse {:.6f}  mean {:.6f}  median {:.6f}  std {:.6f}  min {:.6f}  "
                      "max {:.6f}  sse {:.6f}  [{}]\n",
                      name, s.rmse, s.mean, s.median, s.std, s.min, s.max, s.sse, unit);
+}
+
+// RMS distance of the positions from their centroid.
+double spread(const Trajectory& traj) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : traj) mean += p.T.translation();
+  mean /= static_cast<double>(traj.size());
+  double sum = 0.0;
+  for (const auto& p : traj) sum += (p.T.translation() - mean).squaredNorm();
+  return std::sqrt(sum / static_cast<double>(traj.size()));
+}
+
+double coverage_of(const Trajectory& gt, const IndexPairs& pairs, bool by_index) {
+  if (by_index) return static_cast<double>(pairs.size()) / static_cast<double>(gt.size());
+  const double span = gt.back().t - gt.front().t;
+  if (!(span > 0.0)) return 1.0;
+  return (gt[pairs.gt.back()].t - gt[pairs.gt.front()].t) / span;
+}
+
+// Why an alignment of these paired trajectories means nothing, or empty.
+std::string degenerate_alignment(const Trajectory& gt, const Trajectory& est, AlignMode mode) {
+  if (mode == AlignMode::kNone) return {};
+  constexpr double kMinSpreadM = 1e-6;
+  if (spread(gt) < kMinSpreadM) return "the paired ground-truth positions all coincide";
+  if (spread(est) < kMinSpreadM) return "the paired estimated positions all coincide (a run that never moved or never started?)";
+  return {};
 }
 
 }  // namespace
@@ -53,9 +81,30 @@ EvalResult evaluate(const Trajectory& gt, const Trajectory& est, const EvalOptio
                                                                               options.t_max_diff),
                                      kMinPairs));
   }
+  r.coverage = coverage_of(gt, r.pairs, options.pair_by_index);
+  if (r.pairs.size() < options.min_pairs || r.coverage < options.min_coverage) {
+    throw InputError("", fmt::format("the estimate covers {:.0f} % of the ground truth with {} pose pairs; "
+                                     "at least {:.0f} % and {} pairs are needed to score it "
+                                     "(--allow-partial scores it anyway)",
+                                     100.0 * r.coverage, r.pairs.size(), 100.0 * options.min_coverage,
+                                     options.min_pairs));
+  }
   r.gt = pick(gt, r.pairs.gt);
   const Trajectory est_paired = pick(est, r.pairs.est);
-  r.alignment = solve_alignment(r.gt, est_paired, options.align);
+  r.degenerate = degenerate_alignment(r.gt, est_paired, options.align);
+  if (r.degenerate.empty()) {
+    r.alignment = solve_alignment(r.gt, est_paired, options.align);
+    if (options.align == AlignMode::kSim3 && !(r.alignment.s > 1e-3 && r.alignment.s < 1e3)) {
+      r.degenerate = fmt::format("the Sim(3) alignment collapses (scale {:g})", r.alignment.s);
+    }
+  }
+  if (!r.degenerate.empty()) {
+    if (!options.allow_degenerate) {
+      throw InputError("", "degenerate alignment: " + r.degenerate + " (--allow-degenerate scores it unaligned)");
+    }
+    r.align = AlignMode::kNone;
+    r.alignment = {};
+  }
   r.est = apply_alignment(est_paired, r.alignment);
 
   r.ape_trans_m = ape_translation(r.gt, r.est);
@@ -75,6 +124,9 @@ nlohmann::json to_json(const ErrorStatistics& s) {
 nlohmann::json to_json(const EvalResult& r) {
   nlohmann::json j;
   j["pairs"] = r.pairs.size();
+  j["coverage"] = r.coverage;
+  j["alignment"] = to_string(r.align);
+  if (!r.degenerate.empty()) j["degenerate"] = r.degenerate;
   j["ape_trans_m"] = to_json(r.ape_trans_stats);
   j["rpe_trans_m"] = to_json(r.rpe_trans_stats);
   j["rpe_rot_deg"] = to_json(r.rpe_rot_stats);
@@ -90,8 +142,11 @@ std::string format_report(const EvalResult& r) {
   out += fmt::format("pairs          {} matched {} (ground truth {} poses, estimate {} poses)\n",
                      r.pairs.size(), r.paired_by_index ? "by index" : "by timestamp", r.gt_poses,
                      r.est_poses);
+  out += fmt::format("coverage       {:.1f} % of the ground truth's {}\n", 100.0 * r.coverage,
+                     r.paired_by_index ? "poses" : "time span");
   out += fmt::format("alignment      {}", to_string(r.align));
   if (r.align == AlignMode::kSim3) out += fmt::format(", scale {:.6f}", r.alignment.s);
+  if (!r.degenerate.empty()) out += " (degenerate: " + r.degenerate + "; scored unaligned)";
   out += "\n";
   out += stats_line("APE trans", "m", r.ape_trans_stats);
   const auto& o = r.rpe_options;

@@ -21,6 +21,15 @@ struct EvalOptions {
   bool pair_by_index = false;   // KITTI files: pose i with pose i, timestamps ignored
   RpeOptions rpe;
   bool kitti_metric = false;
+  // Refusals (InputError) of an estimate that would score well for the wrong reason. The library
+  // defaults refuse nothing beyond 3 pairs; `plslam eval` sets the thresholds below unless
+  // --allow-partial / --allow-degenerate lift them.
+  double min_coverage = 0.0;    // share of the ground truth's time span (or poses, by index) paired
+  std::size_t min_pairs = 3;
+  // A ground truth or estimate whose positions all coincide (a failed start writes identity
+  // poses), or a Sim(3) scale that collapses, cannot be aligned meaningfully: refuse, or, when
+  // allowed, score without alignment and say so.
+  bool allow_degenerate = false;
 };
 
 struct EvalResult {
@@ -28,6 +37,8 @@ struct EvalResult {
   std::size_t est_poses = 0;
   bool paired_by_index = false;
   IndexPairs pairs;                    // into the input trajectories
+  double coverage = 0.0;               // share of the ground truth the pairs span (time, or poses by index)
+  std::string degenerate;              // why the alignment was dropped (allow_degenerate), else empty
   AlignMode align = AlignMode::kSE3;
   geometry::AlignmentResult alignment; // estimate -> ground truth
   Trajectory gt;                       // paired ground truth
@@ -48,7 +59,8 @@ struct EvalResult {
 EvalResult evaluate(const Trajectory& gt, const Trajectory& est, const EvalOptions& options);
 
 nlohmann::json to_json(const ErrorStatistics& s);
-// {pairs, ape_trans_m, rpe_trans_m, rpe_rot_deg[, kitti: {t_rel_percent, r_rel_deg_per_100m}]}
+// {pairs, coverage, alignment[, degenerate], ape_trans_m, rpe_trans_m, rpe_rot_deg[, kitti:
+// {t_rel_percent, r_rel_deg_per_100m}]}
 nlohmann::json to_json(const EvalResult& r);
 
 // A few aligned lines for a person to read.

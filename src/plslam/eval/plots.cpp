@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <vector>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "plslam/core/error.h"
 #include "plslam/eval/chart.h"
+#include "plslam/io/atomic_file.h"
 
 namespace plslam::eval {
 namespace {
@@ -19,8 +21,13 @@ const cv::Scalar kBlue(180, 119, 31), kOrange(14, 127, 255), kGreen(44, 160, 44)
 
 constexpr std::array<const char*, 3> kAxisNames = {"x", "y", "z"};
 
+// Encoded in memory and written whole or not at all, like every other output.
 void save(const cv::Mat& img, const std::filesystem::path& path) {
-  if (!cv::imwrite(path.string(), img)) throw InputError(path.string(), "cannot write the plot");
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", img, png)) throw InputError(path.string(), "cannot encode the plot");
+  io::write_file_atomically(path, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  });
 }
 
 void add_statistic_lines(Chart& c, const ErrorStatistics& s, const char* unit) {
