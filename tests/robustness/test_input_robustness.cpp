@@ -2,21 +2,15 @@
 // mark, CRLF), trailing slashes, symlinked folders, JPEG and PGM image folders, the dataset root
 // `plslam synth --format kitti` writes, a folder where a file belongs and the other way round, a
 // zero baseline, out-of-range numbers on the command line, `synth` into a used folder, and stdout
-// of `--json` commands while OpenCV logs. Each case runs the CLI and asserts the exit code, the
+// of `--json` commands while OpenCV logs. (Signals: test_signal_robustness.cpp.) Each case runs the CLI and asserts the exit code, the
 // message (one line, naming the file) or what was accepted, and what was left on disk.
-#include <csignal>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <optional>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
-
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -478,34 +472,6 @@ TEST(ConfigRobustness, ByteOrderMarkAndCrlfConfigIsRead) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto stats = nlohmann::json::parse(slurp(tmp.path() / "out" / "stats.json"));
   EXPECT_EQ(stats["seed"], 7);
-}
-
-// ---- SIGTERM stops synth, which leaves no dataset and no staging folder behind. ----
-
-TEST(SynthSignalRobustness, SigtermLeavesNoDatasetAndExits143) {
-  test::TempDir tmp;
-  const fs::path out = tmp.path() / "s", log = tmp.path() / "synth.log";
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    execl(PLSLAM_CLI_PATH, PLSLAM_CLI_PATH, "synth", "--scene", "office", "--preset", "euroc", "--frames", "400",
-          "--threads", "1", "--out", out.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  // The first progress line means rendering has begun.
-  for (int i = 0; i < 1200 && slurp(log).find("frames, ETA") == std::string::npos; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  kill(pid, SIGTERM);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFEXITED(status)) << slurp(log);
-  EXPECT_EQ(WEXITSTATUS(status), 143) << slurp(log);
-  EXPECT_NE(slurp(log).find("stopped by SIGTERM"), std::string::npos) << slurp(log);
-  EXPECT_FALSE(fs::exists(out));
-  EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator()), 1) << "staging folder left";
 }
 
 }  // namespace

@@ -4,16 +4,18 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
 #include "command_registry.h"
-#include "json_stdout.h"
 #include "commands/dataset_options.h"
+#include "json_stdout.h"
 #include "plslam/core/error.h"
 #include "plslam/core/sample_stats.h"
 #include "plslam/features/line_benchmark.h"
 #include "plslam/features/point_benchmark.h"
 #include "plslam/io/frame_stream.h"
 #include "plslam/tracking/frame_extractor.h"
+#include "stop_signals.h"
 
 namespace plslam::cli {
 namespace {
@@ -43,6 +45,7 @@ nlohmann::json frame_benchmark(const io::Dataset& ds, bool kitti) {
   io::FrameStream stream(ds);
   long id = 0;
   while (auto f = stream.next()) {
+    if (id > 0 && app::stop_requested()) break;
     tracking::FrameTimings t;
     extractor.extract(id++, f->timestamp, f->left, f->right, &t);
     ms.push_back(t.total_ms);
@@ -51,7 +54,10 @@ nlohmann::json frame_benchmark(const io::Dataset& ds, bool kitti) {
 }
 
 int run_bench_features(const BenchFeaturesArgs& args) {
+  // SIGINT/SIGTERM/SIGHUP: each stage stops at its next frame and the frames measured are reported.
+  app::install_stop_signals();
   const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
+  const auto stop = [] { return app::stop_requested(); };
   if (ds->size() == 0) throw InputError(args.dataset.path, "no frames selected");
   features::PointBenchmarkOptions o;
   o.n_features = args.n_features;
@@ -61,6 +67,7 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   if (!features::fast_impl_available(o.orb.fast_impl))
     throw InputError("", std::string("--fast-impl ") + args.fast_impl + " is not available on this CPU");
   o.right_feature_factor = args.right_factor;
+  o.stop = stop;
   if (!(o.right_feature_factor >= 1.0)) throw InputError("", "--right-factor must be >= 1");
   nlohmann::json j = features::run_point_benchmark(*ds, o);
   // Lines: the same frames, one thread, with OpenCV LSD + LBD timed as the reference.
@@ -69,8 +76,20 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   lo.extractor = kitti ? features::LineExtractorOptions::kitti() : features::LineExtractorOptions::euroc();
   // As the SLAM front end keeps them: only lines steep enough for stereo compete for the N places.
   lo.extractor.min_angle_from_horizontal_deg = lo.stereo.min_angle_from_horizontal_deg;
-  j.update(features::benchmark_lines(*ds, 0, lo));
-  j["frame_ms"] = frame_benchmark(*ds, kitti);
+  lo.stop = stop;
+  if (!app::stop_requested()) j.update(features::benchmark_lines(*ds, 0, lo));
+  if (!app::stop_requested()) j["frame_ms"] = frame_benchmark(*ds, kitti);
+  if (app::stop_requested()) {
+    // The stages measured so far, marked: a partial benchmark must not pass for a whole one.
+    j["interrupted_by"] = app::stop_signal_name();
+    spdlog::warn("bench: stopped by {}; the stages and frames measured so far follow", app::stop_signal_name());
+    if (args.json) {
+      print_json(j.dump(2) + "\n");
+    } else {
+      std::cout << j.dump(2) << "\n";
+    }
+    return app::stop_exit_code();
+  }
   if (args.json) {
     print_json(j.dump(2) + "\n");
     return 0;

@@ -106,6 +106,7 @@ nlohmann::json benchmark_lines(const io::Dataset& dataset, std::size_t n, const 
   std::vector<std::pair<cv::Mat, cv::Mat>> frames;
   frames.reserve(count);
   for (std::size_t i = 0; i < count; ++i) {
+    if (i > 0 && o.stop && o.stop()) break;
     io::StereoFrame f = dataset.load(i);
     frames.emplace_back(std::move(f.left), std::move(f.right));
   }

@@ -3,6 +3,7 @@
 // OpenCV LSD (reference) vs our region-growing detector, merging, our LBD, OpenCV's LBD on
 // the same kept lines (for the ratio), and stereo matching. Runs on the calling thread.
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -20,6 +21,8 @@ struct LineBenchmarkOptions {
   LineExtractorOptions extractor;  // kind is forced to kGrow for the fast path
   matching::StereoLineMatchOptions stereo;
   bool reference = true;  // also time OpenCV LSD (full resolution) and OpenCV LBD
+  // Polled before loading each frame after the first: true measures only the frames loaded so far.
+  std::function<bool()> stop;
 };
 
 // Keys (each {median, p90} over frames): lsd_ms, fast_lines_ms, merge_ms, lbd_ms,

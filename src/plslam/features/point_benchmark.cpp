@@ -81,6 +81,7 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
   std::vector<double> candidates, kept_ssc, kept_quadtree, matches, match_share, cv_ssc, cv_quadtree;
   cv::Size size;
   for (std::size_t i = 0; i < frames; ++i) {
+    if (i > 0 && options.stop && options.stop()) break;
     const io::StereoFrame frame = dataset.load(i);
     size = frame.left.size();
     // The first frame runs twice: the first pass only warms caches and allocations.

@@ -3,6 +3,7 @@
 // pyramid, FAST, SSC and quadtree on the same candidates, descriptors, stereo matching, plus
 // keypoint counts and spatial uniformity. One thread, so the numbers are per-core costs.
 #include <cstddef>
+#include <functional>
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +18,9 @@ struct PointBenchmarkOptions {
   int n_features = 0;             // 0: 1200 for EuRoC, 2000 for KITTI
   OrbOptions orb;                 // n_features is overridden as above
   double right_feature_factor = 2.0;
+  // Polled before each frame after the first: true ends the benchmark with the frames measured
+  // so far (a signal asked the program to stop).
+  std::function<bool()> stop;
 };
 
 // JSON keys: pyramid_ms, fast_ms, ssc_ms, quadtree_ms, orb_ms, left_extract_ms,
