@@ -14,6 +14,7 @@
 #include "fuzz/targets/fuzz_frame_log.cpp"
 #include "fuzz/targets/fuzz_image.cpp"
 #include "fuzz/targets/fuzz_trajectory.cpp"
+#include "fuzz/targets/fuzz_vocabulary.cpp"
 
 namespace plslam::fuzz {
 namespace {
@@ -36,6 +37,7 @@ const Target kTargets[] = {
     {"kitti_times", fuzz_kitti_times},
     {"frame_log", fuzz_frame_log},
     {"image", fuzz_image},
+    {"vocabulary", fuzz_vocabulary},
 };
 
 class FuzzReplay : public testing::TestWithParam<Target> {};
