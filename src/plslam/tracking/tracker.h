@@ -92,6 +92,8 @@ class Tracker {
  private:
   bool initialize(Frame& f);
   bool track_with_motion_model(Frame& f, TrackStageTimes& t);
+  // Pose from PnP RANSAC on the frame's point matches, when it succeeds.
+  std::optional<geometry::SE3> pnp_from_matches(const Frame& f) const;
   bool track_reference_keyframe(Frame& f, TrackStageTimes& t);
   bool track_local_map(Frame& f, TrackStageTimes& t, int& point_inliers, int& line_inliers);
   int optimize_pose(Frame& f, TrackStageTimes& t);
