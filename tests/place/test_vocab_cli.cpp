@@ -16,13 +16,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 TEST(VocabCli, TrainsAReproducibleVocabularyThatRecognisesANeighbouringFrame) {
   PLSLAM_REQUIRE_SHARED_DATA(data);
   test::TempDir tmp;
@@ -35,7 +28,7 @@ TEST(VocabCli, TrainsAReproducibleVocabularyThatRecognisesANeighbouringFrame) {
   EXPECT_NE(a.err.find("ETA"), std::string::npos) << "no progress: " << a.err;
   const auto b = test::run_cli(args + "\"" + (tmp.path() / "b.voc").string() + "\"");
   ASSERT_EQ(b.exit_code, 0) << b.err;
-  EXPECT_EQ(slurp(tmp.path() / "a.voc"), slurp(tmp.path() / "b.voc")) << "same seed, different vocabulary";
+  EXPECT_EQ(test::read_file(tmp.path() / "a.voc"), test::read_file(tmp.path() / "b.voc")) << "same seed, different vocabulary";
 
   const Vocabulary voc = Vocabulary::load(tmp.path() / "a.voc");
   EXPECT_EQ(voc.k(), 6);

@@ -25,20 +25,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 void overwrite(const fs::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary | std::ios::trunc) << text;
 }
 
 // Rewrites a text file as a Windows editor saves it: CRLF line ends and/or a UTF-8 byte-order mark.
 void windows_style(const fs::path& p, bool bom, bool crlf) {
-  std::string text = slurp(p), out = bom ? "\xEF\xBB\xBF" : "";
+  std::string text = test::read_file(p), out = bom ? "\xEF\xBB\xBF" : "";
   for (char c : text) {
     if (c == '\n' && crlf) out += '\r';
     out += c;
@@ -386,7 +379,7 @@ const InputCase kCases[] = {
      },
      2, {"not empty", "--force"},
      [](const fs::path& tmp, const test::CliResult&) {
-       EXPECT_EQ(slurp(tmp / "s" / "old.txt"), "keep me");
+       EXPECT_EQ(test::read_file(tmp / "s" / "old.txt"), "keep me");
        EXPECT_FALSE(fs::exists(tmp / "s" / "mav0"));
      }},
     {"synth_force_replaces_the_folder", "synth into a used folder",
@@ -417,7 +410,7 @@ const InputCase kCases[] = {
        test::write_file(tmp / "s", "x");
        return synth_args(tmp / "s");
      },
-     2, {"is a file"}, [](const fs::path& tmp, const test::CliResult&) { EXPECT_EQ(slurp(tmp / "s"), "x"); }},
+     2, {"is a file"}, [](const fs::path& tmp, const test::CliResult&) { EXPECT_EQ(test::read_file(tmp / "s"), "x"); }},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cases, InputRobustness, ::testing::ValuesIn(kCases),
@@ -470,7 +463,7 @@ TEST(ConfigRobustness, ByteOrderMarkAndCrlfConfigIsRead) {
   const auto r = test::run_cli("run " + q(data / "kitti/sequences/06") + " --max-frames 4 --sequential --quiet --out " +
                                q(tmp.path() / "out") + " --config " + q(tmp.path() / "cfg.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const auto stats = nlohmann::json::parse(slurp(tmp.path() / "out" / "stats.json"));
+  const auto stats = nlohmann::json::parse(test::read_file(tmp.path() / "out" / "stats.json"));
   EXPECT_EQ(stats["seed"], 7);
 }
 

@@ -21,13 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // True once `pid` has a handler for SIGTERM (the SigCgt mask of /proc/<pid>/status).
 bool catches_sigterm(pid_t pid) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
@@ -57,7 +50,7 @@ Stopped start_and_stop(const fs::path& dir, const std::vector<std::string>& args
     execv(PLSLAM_CLI_PATH, argv.data());
     _exit(127);
   }
-  for (int i = 0; i < 1200 && !(catches_sigterm(pid) && ready(slurp(err))); ++i) {
+  for (int i = 0; i < 1200 && !(catches_sigterm(pid) && ready(test::read_file(err))); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   kill(pid, SIGTERM);
@@ -65,8 +58,8 @@ Stopped start_and_stop(const fs::path& dir, const std::vector<std::string>& args
   waitpid(pid, &status, 0);
   Stopped s;
   s.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 1000 + WTERMSIG(status);
-  s.out = slurp(out);
-  s.err = slurp(err);
+  s.out = test::read_file(out);
+  s.err = test::read_file(err);
   return s;
 }
 

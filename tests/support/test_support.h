@@ -34,6 +34,9 @@ struct CliResult {
   std::string err;  // stderr
 };
 
+// The whole file, bytes as they are; empty when it cannot be read.
+std::string read_file(const std::filesystem::path& p);
+
 // Runs build/plslam with the given argument string (shell-quoted by the caller).
 CliResult run_cli(const std::string& args);
 
