@@ -42,14 +42,17 @@ for t in "${targets[@]}"; do
   mkdir -p "$corpus" "$crashes"
   log="$BUILD_DIR/fuzz_$t.log"
   echo "=== fuzz_$t for $seconds s"
+  # Artifacts of earlier runs stay in $crashes for inspection; only this run's are counted.
+  stamp="$BUILD_DIR/.fuzz_start_$t"
+  touch "$stamp"
   rc=0
   "$BUILD_DIR/fuzz_$t" -max_total_time="$seconds" -max_len=8192 -timeout=10 -rss_limit_mb=2048 \
     -artifact_prefix="$crashes/" -print_final_stats=1 "$corpus" "tests/fuzz/corpus/$t" >"$log" 2>&1 || rc=$?
   execs=$(sed -nE 's/^stat::number_of_executed_units: *([0-9]+)/\1/p' "$log" | tail -1)
   cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -1 | cut -d' ' -f2)
   ft=$(grep -oE 'ft: [0-9]+' "$log" | tail -1 | cut -d' ' -f2)
-  found=$(find "$crashes" -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
-  slow=$(find "$crashes" -type f -name 'slow-unit-*' | wc -l)
+  found=$(find "$crashes" -type f -newer "$stamp" \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
+  slow=$(find "$crashes" -type f -newer "$stamp" -name 'slow-unit-*' | wc -l)
   echo "fuzz_$t: exit $rc, ${execs:-?} executions, edge coverage ${cov:-?}, features ${ft:-?}, corpus $(ls "$corpus" | wc -l) files, crashes $found, slow inputs $slow (log $log)"
   if [ "$rc" -ne 0 ] || [ "$found" -ne 0 ]; then status=1; fi
 done
