@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "plslam/core/error.h"
+#include "plslam/core/input_file.h"
 
 namespace plslam {
 
@@ -32,10 +33,7 @@ ConfigReader ConfigReader::from_string(const std::string& yaml, const std::strin
 }
 
 ConfigReader ConfigReader::from_file(const std::filesystem::path& path) {
-  if (!std::filesystem::exists(path)) throw InputError(path.string(), "configuration file not found");
-  if (std::filesystem::is_directory(path)) throw InputError(path.string(), "is a folder, expected a file");
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string(), "cannot open configuration file");
+  std::ifstream in = open_text_file(path, "configuration file not found");
   std::stringstream ss;
   ss << in.rdbuf();
   return from_string(ss.str(), path.string());

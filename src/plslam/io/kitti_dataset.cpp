@@ -218,9 +218,8 @@ class KittiDataset final : public Dataset {
 }  // namespace
 
 std::unique_ptr<Dataset> open_kitti(const fs::path& sequence_dir, const DatasetOptions& options) {
-  auto root = fs::absolute(sequence_dir).lexically_normal();
-  if (root.filename().empty()) root = root.parent_path();
-  return std::make_unique<KittiDataset>(root, options);
+  // open_dataset has already dropped a trailing slash.
+  return std::make_unique<KittiDataset>(fs::absolute(sequence_dir).lexically_normal(), options);
 }
 
 }  // namespace plslam::io::detail

@@ -22,26 +22,6 @@ double parse_finite(const std::string& field, const std::filesystem::path& path,
   return v;
 }
 
-std::ifstream open_text_file(const std::filesystem::path& path, const char* missing) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) throw InputError(path.string(), missing);
-  if (std::filesystem::is_directory(status)) throw InputError(path.string(), "is a folder, expected a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "cannot open file (permission denied?)");
-  char bom[3] = {};
-  in.read(bom, 3);
-  if (!(in.gcount() == 3 && bom[0] == '\xEF' && bom[1] == '\xBB' && bom[2] == '\xBF')) {
-    in.clear();
-    in.seekg(0);
-  }
-  return in;
-}
-
-void strip_cr(std::string& line) {
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-}
-
 std::vector<NumericRow> read_numeric_rows(const std::filesystem::path& path) {
   std::ifstream in = open_text_file(path);
   std::vector<NumericRow> rows;

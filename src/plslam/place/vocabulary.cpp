@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "plslam/core/error.h"
+#include "plslam/core/input_file.h"
 
 namespace plslam::place {
 namespace {
@@ -243,11 +244,8 @@ Vocabulary Vocabulary::from_bytes(const std::string& bytes, const std::string& s
 }
 
 Vocabulary Vocabulary::load(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path.string(), "vocabulary file not found");
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path.string(), "is a folder, expected a vocabulary file");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError(path.string(), "cannot open the vocabulary file");
+  std::ifstream in = open_input_file(path, "vocabulary file not found");
+  in.seekg(0, std::ios::end);
   const auto size = static_cast<std::size_t>(in.tellg());
   std::string bytes(size, '\0');
   in.seekg(0);
