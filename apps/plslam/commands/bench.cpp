@@ -79,21 +79,19 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   lo.stop = stop;
   if (!app::stop_requested()) j.update(features::benchmark_lines(*ds, 0, lo));
   if (!app::stop_requested()) j["frame_ms"] = frame_benchmark(*ds, kitti);
-  if (app::stop_requested()) {
-    // The stages measured so far, marked: a partial benchmark must not pass for a whole one.
+  const bool interrupted = app::stop_requested();
+  if (interrupted) {
+    // The stages measured so far, marked: a partial benchmark must not pass for a whole one. The
+    // table below needs every stage, so a person gets the JSON too.
     j["interrupted_by"] = app::stop_signal_name();
     spdlog::warn("bench: stopped by {}; the stages and frames measured so far follow", app::stop_signal_name());
-    if (args.json) {
-      print_json(j.dump(2) + "\n");
-    } else {
-      std::cout << j.dump(2) << "\n";
-    }
-    return app::stop_exit_code();
   }
   if (args.json) {
     print_json(j.dump(2) + "\n");
-    return 0;
+  } else if (interrupted) {
+    std::cout << j.dump(2) << "\n";
   }
+  if (args.json || interrupted) return interrupted ? app::stop_exit_code() : 0;
   std::cout << fmt::format("{} ({}), {} frames, {}x{}, {} features, FAST {}, one thread\n", j["dataset"].get<std::string>(),
                            j["format"].get<std::string>(), j["frames"].get<int>(), j["width"].get<int>(),
                            j["height"].get<int>(), j["config"]["n_features"].get<int>(),

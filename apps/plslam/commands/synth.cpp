@@ -13,6 +13,7 @@
 #include "plslam/core/log.h"
 #include "plslam/io/output_folder.h"
 #include "plslam/synth/writer.h"
+#include "progress_eta.h"
 #include "stop_signals.h"
 
 namespace {
@@ -115,9 +116,7 @@ int run(const Options& o) {
       [&](std::size_t done, std::size_t total) {
         if (done == total || done >= last + std::max<std::size_t>(1, total / 10)) {
           last = done;
-          const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-          const double eta = elapsed / static_cast<double>(done) * static_cast<double>(total - done);
-          spdlog::info("synth: {}/{} frames, ETA {:.0f} s", done, total, eta);
+          spdlog::info("synth: {}/{} frames, ETA {:.0f} s", done, total, plslam::cli::eta_seconds(start, done, total));
         }
       },
       o.threads, [] { return plslam::app::stop_requested(); });

@@ -14,6 +14,7 @@
 #include "plslam/io/atomic_file.h"
 #include "plslam/io/dataset.h"
 #include "plslam/place/vocabulary_training.h"
+#include "progress_eta.h"
 #include "stop_signals.h"
 
 namespace plslam::cli {
@@ -38,6 +39,12 @@ std::vector<std::size_t> pick_frames(std::size_t size, std::size_t n) {
   if (n == 0 || n >= size) n = size;
   for (std::size_t i = 0; i < n; ++i) picked.push_back(i * size / n);
   return picked;
+}
+
+// A signal stops training before anything is written.
+int stopped() {
+  spdlog::warn("vocab: stopped by {}; nothing written", app::stop_signal_name());
+  return app::stop_exit_code();
 }
 
 int run_vocab_train(const VocabTrainArgs& args) {
@@ -77,17 +84,12 @@ int run_vocab_train(const VocabTrainArgs& args) {
     const features::OrbExtractor extractor(ds.format() == io::DatasetFormat::kKitti ? features::OrbOptions::kitti()
                                                                                       : features::OrbOptions::euroc());
     for (std::size_t i : frames[d]) {
-      if (app::stop_requested()) {
-        spdlog::warn("vocab: stopped by {}; nothing written", app::stop_signal_name());
-        return app::stop_exit_code();
-      }
+      if (app::stop_requested()) return stopped();
       const auto features = extractor.extract(ds.load(i).left);
       descriptors.push_back(place::descriptors_from_mat(features.descriptors));
       total_descriptors += descriptors.back().size();
       if (++done % 20 == 0 || done == images) {
-        const double elapsed = seconds_since(t0);
-        spdlog::info("vocab: features of {}/{} images, ETA {:.0f} s", done, images,
-                     elapsed / static_cast<double>(done) * static_cast<double>(images - done));
+        spdlog::info("vocab: features of {}/{} images, ETA {:.0f} s", done, images, eta_seconds(t0, done, images));
       }
     }
   }
@@ -96,15 +98,10 @@ int run_vocab_train(const VocabTrainArgs& args) {
   const place::Vocabulary voc = place::train_vocabulary(descriptors, options, [&](std::size_t placed, std::size_t all) {
     if (placed == all || placed >= last + all / 10) {
       last = placed;
-      const double elapsed = seconds_since(t1);
-      spdlog::info("vocab: clustered {}/{} descriptors, ETA {:.0f} s", placed, all,
-                   placed > 0 ? elapsed / static_cast<double>(placed) * static_cast<double>(all - placed) : 0.0);
+      spdlog::info("vocab: clustered {}/{} descriptors, ETA {:.0f} s", placed, all, eta_seconds(t1, placed, all));
     }
   });
-  if (app::stop_requested()) {
-    spdlog::warn("vocab: stopped by {}; nothing written", app::stop_signal_name());
-    return app::stop_exit_code();
-  }
+  if (app::stop_requested()) return stopped();
   const std::string bytes = voc.to_bytes();
   io::write_file_atomically(args.out, [&](std::ostream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); });
   std::cout << fmt::format("vocabulary {}: {} words, {} nodes, {:.2f} MB, from {} descriptors of {} images in {:.1f} s\n",
