@@ -3,7 +3,9 @@
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "plslam/core/error.h"
 #include "plslam/features/orb_extractor.h"
@@ -66,6 +68,42 @@ TEST(VocabCli, DamagedVocabularyFileIsRefusedByName) {
   }
   EXPECT_THROW(Vocabulary::load(tmp.path() / "missing.voc"), InputError);
   EXPECT_THROW(Vocabulary::load(tmp.path()), InputError);
+}
+
+}  // namespace
+}  // namespace plslam::place
+
+namespace plslam::place {
+namespace {
+
+// vocab eval on the KITTI 06 excerpt: it never revisits a place (every query is a non-revisit),
+// and the JSON says so; a dataset without ground truth cannot be scored.
+TEST(VocabCli, EvalReportsThePrecisionRecallOfADataset) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  const auto seq = data / "kitti" / "sequences" / "06";
+  const auto r = test::run_cli("vocab eval \"" + seq.string() + "\" --every 5 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["keyframes"], 11);
+  EXPECT_EQ(j["every"], 5);
+  // 10 m between keyframes 5 frames apart: nothing within 2 m over 2 s earlier.
+  EXPECT_EQ(j["queries_with_true_match"], 0);
+  EXPECT_EQ(j["recall_at_precision"], 0.0);
+  EXPECT_GT(j["queries"].get<int>(), 0);
+  EXPECT_TRUE(j["curve"].is_array());
+  test::TempDir tmp;
+  fs::create_directories(tmp.path() / "seq" / "image_0");
+  fs::create_directories(tmp.path() / "seq" / "image_1");
+  fs::copy_file(seq / "calib.txt", tmp.path() / "seq" / "calib.txt");
+  std::ofstream(tmp.path() / "seq" / "times.txt") << "0.0\n0.1\n0.2\n";
+  for (int i = 0; i < 3; ++i) {
+    const auto name = fmt::format("{:06d}.png", i);
+    fs::copy_file(seq / "image_0" / name, tmp.path() / "seq" / "image_0" / name);
+    fs::copy_file(seq / "image_1" / name, tmp.path() / "seq" / "image_1" / name);
+  }
+  const auto no_gt = test::run_cli("vocab eval \"" + (tmp.path() / "seq").string() + "\"");
+  EXPECT_EQ(no_gt.exit_code, 2);
+  EXPECT_NE(no_gt.err.find("no ground truth"), std::string::npos) << no_gt.err;
 }
 
 }  // namespace

@@ -12,19 +12,10 @@
 #include "plslam/place/bow_vector.h"
 #include "plslam/place/vocabulary.h"
 #include "plslam/place/vocabulary_training.h"
+#include "place/synthetic_descriptors.h"
 
 namespace plslam::place {
 namespace {
-
-Descriptor256 random_descriptor(std::mt19937_64& rng) { return {rng(), rng(), rng(), rng()}; }
-
-Descriptor256 flip_bits(Descriptor256 d, int bits, std::mt19937_64& rng) {
-  for (int i = 0; i < bits; ++i) {
-    const auto b = rng() % 256;
-    d[b / 64] ^= std::uint64_t{1} << (b % 64);
-  }
-  return d;
-}
 
 // `clusters` random prototypes (about 128 bits apart); image i holds `per_image` noisy copies
 // (8 flipped bits) of prototypes i % clusters and (i + 1) % clusters.

@@ -44,6 +44,8 @@ struct RunArgs {
   DatasetArgs dataset;
   std::string out;
   std::string config;
+  std::string vocabulary;
+  bool no_place_recognition = false;
   bool no_lines = false;
   bool quiet = false;
   bool realtime = false;
@@ -60,12 +62,16 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
       ds->format(), args.config.empty() ? std::nullopt : std::optional<fs::path>(args.config));
   if (args.no_lines) options.disable_lines();
   options.sequential = args.sequential;
+  if (!args.vocabulary.empty()) options.vocabulary = args.vocabulary;
+  if (args.no_place_recognition) options.place_recognition = false;
+  const auto vocabulary = system::load_vocabulary(options);  // InputError naming the file
 
-  spdlog::info("{}: {} frames, {}x{}, {:.1f} fps, baseline {:.3f} m, lines {}", ds->root().string(), ds->size(),
-               ds->calibration().width, ds->calibration().height, ds->fps(), ds->calibration().baseline,
-               options.extractor.lines ? "on" : "off");
+  spdlog::info("{}: {} frames, {}x{}, {:.1f} fps, baseline {:.3f} m, lines {}, place recognition {}", ds->root().string(),
+               ds->size(), ds->calibration().width, ds->calibration().height, ds->fps(), ds->calibration().baseline,
+               options.extractor.lines ? "on" : "off",
+               vocabulary ? fmt::format("on ({} words)", vocabulary->size()) : std::string("off"));
 
-  system::System slam(ds->calibration(), options);
+  system::System slam(ds->calibration(), options, vocabulary);
   system::RunReport report;
   app::install_stop_signals();
   std::string fatal;
@@ -213,6 +219,10 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                            sub.add_option("--out", args->out, "Output folder")->required();
                            sub.add_option("--config", args->config,
                                           "YAML configuration (default: the preset for the dataset format)");
+                           sub.add_option("--vocabulary", args->vocabulary,
+                                          "Vocabulary file for place recognition (default: the one in data/vocabulary)");
+                           sub.add_flag("--no-place-recognition", args->no_place_recognition,
+                                        "No relocalization: a lost camera starts a new map segment");
                            sub.add_flag("--no-lines", args->no_lines, "Points only");
                            sub.add_flag("--quiet", args->quiet, "No progress lines");
                            sub.add_flag("--realtime", args->realtime, "Pace the input at the dataset's frame rate");

@@ -1,19 +1,28 @@
 // plslam vocab train <dataset>... --out FILE: plslam's own visual vocabulary, from the ORB
 // descriptors its extractor computes on the left images of any number of datasets.
+// plslam vocab info FILE [--json]: a vocabulary file's parameters (after the loader's checks).
+// plslam vocab eval <dataset> [--vocabulary F] [--every N] [--json]: place recognition's
+// precision-recall on a sequence with ground truth (src/plslam/place/recognition_eval.h).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <filesystem>
 #include <memory>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "command_registry.h"
+#include "json_stdout.h"
 #include "plslam/core/error.h"
 #include "plslam/features/orb_extractor.h"
 #include "plslam/io/atomic_file.h"
 #include "plslam/io/dataset.h"
+#include "plslam/place/recognition_eval.h"
 #include "plslam/place/vocabulary_training.h"
+#include "plslam/system/system_config.h"
 #include "progress_eta.h"
 #include "stop_signals.h"
 
@@ -110,6 +119,103 @@ int run_vocab_train(const VocabTrainArgs& args) {
   return 0;
 }
 
+struct VocabInfoArgs {
+  std::string file;
+  bool json = false;
+};
+
+int run_vocab_info(const VocabInfoArgs& args) {
+  const auto t0 = Clock::now();
+  const auto voc = place::Vocabulary::load(args.file);  // InputError (exit 2) for a bad file
+  const double load_ms = 1e3 * seconds_since(t0);
+  std::size_t used_levels = 0;
+  for (const auto& n : voc.nodes()) used_levels = std::max<std::size_t>(used_levels, n.depth);
+  const auto bytes = std::filesystem::file_size(args.file);
+  if (args.json) {
+    nlohmann::json j = {{"file", args.file},     {"format_version", 1},          {"descriptor", "ORB (256 bits)"},
+                        {"k", voc.k()},          {"levels", voc.levels()},      {"deepest_leaf", used_levels},
+                        {"words", voc.size()},   {"nodes", voc.nodes().size()}, {"bytes", bytes},
+                        {"load_ms", load_ms}};
+    print_json(j.dump(2) + "\n");
+    return 0;
+  }
+  std::cout << fmt::format(
+      "{}: plslam vocabulary v1, ORB (256 bits), k = {}, L = {} (deepest leaf {}), {} words, {} nodes, "
+      "{:.2f} MB, checksum ok, loaded in {:.1f} ms\n",
+      args.file, voc.k(), voc.levels(), used_levels, voc.size(), voc.nodes().size(), static_cast<double>(bytes) / 1e6,
+      load_ms);
+  return 0;
+}
+
+struct VocabEvalArgs {
+  std::string dataset;
+  std::string vocabulary;  // empty: the default
+  int every = 10;
+  double precision = 0.95;
+  bool json = false;
+};
+
+int run_vocab_eval(const VocabEvalArgs& args) {
+  app::install_stop_signals();
+  const auto ds = io::open_dataset(args.dataset);
+  if (!ds->ground_truth()) throw InputError(ds->root().string(), "no ground truth: place recognition cannot be scored");
+  const std::filesystem::path voc_path =
+      args.vocabulary.empty() ? system::default_vocabulary_path() : std::filesystem::path(args.vocabulary);
+  auto vocabulary = std::make_shared<const place::Vocabulary>(place::Vocabulary::load(voc_path));
+  const features::OrbExtractor extractor(ds->format() == io::DatasetFormat::kKitti ? features::OrbOptions::kitti()
+                                                                                    : features::OrbOptions::euroc());
+  const auto& gt = *ds->ground_truth();
+  const double tolerance = ds->fps() > 0 ? 0.5 / ds->fps() : 0.01;
+  std::vector<place::PlaceSample> samples;
+  const auto t0 = Clock::now();
+  const std::size_t total = (ds->size() + static_cast<std::size_t>(args.every) - 1) / static_cast<std::size_t>(args.every);
+  for (std::size_t i = 0; i < ds->size(); i += static_cast<std::size_t>(args.every)) {
+    if (app::stop_requested()) return stopped();
+    const double t = ds->timestamps()[i];
+    const auto it = std::lower_bound(gt.begin(), gt.end(), t - tolerance,
+                                     [](const StampedPose& p, double v) { return p.t < v; });
+    if (it == gt.end() || std::abs(it->t - t) > tolerance) continue;  // no ground truth for this frame
+    place::PlaceSample s;
+    s.timestamp = t;
+    s.centre = it->T.translation();
+    s.direction = it->T.linear() * Eigen::Vector3d::UnitZ();
+    s.descriptors = extractor.extract(ds->load(i).left).descriptors;
+    samples.push_back(std::move(s));
+    if (!args.json && samples.size() % 20 == 0) {
+      spdlog::info("vocab eval: features of {}/{} keyframes, ETA {:.0f} s", samples.size(), total,
+                   eta_seconds(t0, samples.size(), total));
+    }
+  }
+  const auto r = place::evaluate_place_recognition(samples, vocabulary);
+  const double recall = r.recall_at_precision(args.precision);
+  double threshold = 0;
+  for (const auto& p : r.curve) {
+    if (p.precision >= args.precision && p.recall == recall) threshold = p.threshold;
+  }
+  if (args.json) {
+    nlohmann::json curve = nlohmann::json::array();
+    for (const auto& p : r.curve) {
+      curve.push_back({{"threshold", p.threshold}, {"accepted", p.accepted}, {"correct", p.correct},
+                       {"precision", p.precision}, {"recall", p.recall}});
+    }
+    nlohmann::json j = {{"dataset", ds->root().string()}, {"vocabulary", voc_path.string()},
+                        {"keyframes", samples.size()},     {"every", args.every},
+                        {"queries", r.queries.size()},      {"queries_with_true_match", r.with_true_match},
+                        {"precision", args.precision},      {"recall_at_precision", recall},
+                        {"threshold", threshold},           {"curve", curve}};
+    print_json(j.dump(2) + "\n");
+    return 0;
+  }
+  const double top1 = r.curve.empty() ? 0 : r.curve.back().precision;
+  std::cout << fmt::format(
+      "{}: {} keyframes (every {} frames), {} queries, {} with a revisit (within 2 m and 30 deg, over 2 s "
+      "earlier)\nrecall {:.3f} at precision >= {:.2f} (score >= {:.4f}); accepting every top candidate: "
+      "precision {:.3f}, recall {:.3f}\n",
+      ds->root().string(), samples.size(), args.every, r.queries.size(), r.with_true_match, recall, args.precision,
+      threshold, top1, r.curve.empty() ? 0.0 : r.curve.back().recall);
+  return 0;
+}
+
 CommandRegistration reg({"vocab", "Train plslam's visual vocabulary (bag of words for place recognition)",
                          [](CLI::App& sub) {
                            sub.require_subcommand(1);
@@ -123,7 +229,25 @@ CommandRegistration reg({"vocab", "Train plslam's visual vocabulary (bag of word
                                ->check(CLI::NonNegativeNumber)->capture_default_str();
                            train->add_option("--max-images", args->max_images, "At most this many images in all (0: every image)")
                                ->check(CLI::Range(0LL, 1'000'000'000LL))->capture_default_str();
-                           return std::function<int()>([args, train] { return train->parsed() ? run_vocab_train(*args) : 2; });
+                           auto info_args = std::make_shared<VocabInfoArgs>();
+                           CLI::App* info = sub.add_subcommand("info", "Print a vocabulary file's parameters");
+                           info->add_option("file", info_args->file, "Vocabulary file")->required();
+                           info->add_flag("--json", info_args->json, "Print a JSON object");
+                           auto eval_args = std::make_shared<VocabEvalArgs>();
+                           CLI::App* eval = sub.add_subcommand(
+                               "eval", "Precision-recall of place recognition on a sequence with ground truth");
+                           eval->add_option("dataset", eval_args->dataset, "KITTI sequences/NN or EuRoC folder")->required();
+                           eval->add_option("--vocabulary", eval_args->vocabulary, "Vocabulary file (default: data/vocabulary)");
+                           eval->add_option("--every", eval_args->every, "One keyframe every N frames")
+                               ->check(CLI::Range(1, 1'000'000))->capture_default_str();
+                           eval->add_option("--precision", eval_args->precision, "Report the recall at this precision")
+                               ->check(CLI::Range(0.0, 1.0))->capture_default_str();
+                           eval->add_flag("--json", eval_args->json, "Print a JSON object");
+                           return std::function<int()>([args, train, info_args, info, eval_args, eval] {
+                             if (info->parsed()) return run_vocab_info(*info_args);
+                             if (eval->parsed()) return run_vocab_eval(*eval_args);
+                             return train->parsed() ? run_vocab_train(*args) : 2;
+                           });
                          }});
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "plslam/geometry/triangulation.h"
 #include "plslam/map/descriptor_utils.h"
 #include "plslam/mapping/epipolar_index.h"
+#include "plslam/place/keyframe_database.h"
 
 namespace plslam::mapping {
 namespace {
@@ -106,6 +107,8 @@ void LocalMapper::run() {
 void LocalMapper::process(map::KeyFrame* kf, bool more_waiting) {
   const auto t0 = Clock::now();
   process_new_keyframe(kf);
+  // The bag of words is computed here, off the tracking thread (ORB-SLAM2 does it in local mapping too).
+  if (database_) database_->add(kf);
   cull_recent(kf);
   auto t = Clock::now();
   triangulate(kf);
@@ -528,6 +531,7 @@ void LocalMapper::cull_keyframes(map::KeyFrame* kf) {
     if (total > 0 && redundant > options_.culling_redundancy * total) {
       k->set_bad();
       map_.erase_keyframe(k);
+      if (database_) database_->erase(k);
       ++culled;
     }
   }

@@ -14,6 +14,10 @@
 #include "plslam/map/map.h"
 #include "plslam/optim/bundle_adjustment.h"
 
+namespace plslam::place {
+class KeyframeDatabase;
+}  // namespace plslam::place
+
 namespace plslam::mapping {
 
 struct LocalMapperOptions {
@@ -50,6 +54,9 @@ class LocalMapper {
   void stop();
 
   void insert(map::KeyFrame* kf);
+  // Place recognition: each processed keyframe is described and added, each culled one forgotten.
+  // Not owned; set before start().
+  void set_keyframe_database(place::KeyframeDatabase* database) { database_ = database; }
   bool idle() const;
   std::size_t queued() const;
   // Processes every queued keyframe in the calling thread (deterministic mode and tests).
@@ -73,6 +80,7 @@ class LocalMapper {
 
   map::Map& map_;
   LocalMapperOptions options_;
+  place::KeyframeDatabase* database_ = nullptr;
 
   mutable std::mutex queue_mutex_;
   std::condition_variable cv_;

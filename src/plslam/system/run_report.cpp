@@ -68,7 +68,16 @@ nlohmann::json RunReport::to_json(const System& slam) const {
           {"frames_before_initialization", before_init},
           {"lost_frames", lost_ids.size()},
           {"lost_frame_ids", lost_ids},
-          {"relocalized_frames", 0},  // no relocalisation yet: a lost camera starts a new map segment
+          {"relocalizations",
+           {{"count", slam.tracker().relocalized_frames().size()}, {"frames", slam.tracker().relocalized_frames()}}},
+          {"new_map_segments",
+           {{"count", slam.tracker().new_segment_frames().size()}, {"frames", slam.tracker().new_segment_frames()}}},
+          {"place_recognition",
+           slam.keyframe_database()
+               ? nlohmann::json{{"enabled", true},
+                                {"vocabulary_words", slam.keyframe_database()->vocabulary().size()},
+                                {"database_keyframes", slam.keyframe_database()->size()}}
+               : nlohmann::json{{"enabled", false}}},
           {"skipped_frames", skipped.size()},
           {"skipped", skipped_json},
           {"untracked_kitti_lines", untracked_lines},
@@ -94,9 +103,11 @@ nlohmann::json RunReport::to_json(const System& slam) const {
 
 std::string RunReport::summary(const System& slam) const {
   return fmt::format(
-      "frames {} (tracked {}, skipped {}), lost events {}, keyframes {}, map points {}, map lines {}\n"
+      "frames {} (tracked {}, skipped {}), lost events {}, relocalizations {}, new map segments {}, keyframes {}, "
+      "map points {}, map lines {}\n"
       "tracking ms/frame: median {:.1f}, mean {:.1f}, p90 {:.1f}\n",
-      frames, tracked_frames, skipped.size(), slam.tracker().lost_events(), slam.map().num_keyframes(), slam.map().num_points(),
+      frames, tracked_frames, skipped.size(), slam.tracker().lost_events(), slam.tracker().relocalized_frames().size(),
+      slam.tracker().new_segment_frames().size(), slam.map().num_keyframes(), slam.map().num_points(),
       slam.map().num_lines(), percentile(tracking_ms, 0.5), mean(tracking_ms), percentile(tracking_ms, 0.9));
 }
 

@@ -37,16 +37,20 @@ void SystemOptions::disable_lines() {
   mapper.lines = false;
 }
 
-System::System(const StereoCalibration& calib, SystemOptions options)
+System::System(const StereoCalibration& calib, SystemOptions options, std::shared_ptr<const place::Vocabulary> vocabulary)
     : options_(std::move(options)), extractor_(calib, options_.extractor) {
   options_.mapper.line_information = options_.tracker.line_information;
   options_.mapper.far_stereo_baselines = options_.tracker.far_stereo_baselines;
+  options_.tracker.seed = options_.seed;
+  if (vocabulary) database_ = std::make_unique<place::KeyframeDatabase>(std::move(vocabulary));
   mapper_ = std::make_unique<mapping::LocalMapper>(map_, options_.mapper);
+  mapper_->set_keyframe_database(database_.get());
   auto* mapper = mapper_.get();
   const bool sequential = options_.sequential;
   tracker_ = std::make_unique<tracking::Tracker>(
       map_, options_.tracker, [mapper](map::KeyFrame* kf) { mapper->insert(kf); },
       [mapper, sequential] { return sequential || mapper->idle(); });
+  tracker_->set_keyframe_database(database_.get());
   if (!sequential) mapper_->start();
 }
 

@@ -3,6 +3,7 @@
 // The caller's thread is the tracking thread; local mapping runs concurrently (or, with
 // `sequential`, in the tracking thread after each keyframe, for reproducible runs).
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -10,6 +11,7 @@
 #include "plslam/io/dataset.h"
 #include "plslam/map/map.h"
 #include "plslam/mapping/local_mapper.h"
+#include "plslam/place/keyframe_database.h"
 #include "plslam/tracking/frame_extractor.h"
 #include "plslam/tracking/tracker.h"
 
@@ -20,10 +22,13 @@ struct SystemOptions {
   tracking::TrackerOptions tracker;
   mapping::LocalMapperOptions mapper;
   bool sequential = false;
-  // Seed of every random choice (config `system.seed`, recorded in stats.json). Today the
-  // pipeline makes none: tracking, mapping and BA are deterministic. The PnP RANSAC of
-  // relocalization (geometry::PnpOptions::seed) takes it.
+  // Seed of every random choice (config `system.seed`, recorded in stats.json): the PnP RANSAC
+  // of relocalization (geometry::PnpOptions::seed). Tracking, mapping and BA make none.
   std::uint32_t seed = 1;
+  // Place recognition (config `place`): the vocabulary of the keyframe database that
+  // relocalization queries; empty: the default vocabulary shipped in data/.
+  bool place_recognition = true;
+  std::filesystem::path vocabulary;
 
   static SystemOptions euroc();
   static SystemOptions kitti();
@@ -41,7 +46,9 @@ struct FrameResult {
 
 class System {
  public:
-  System(const StereoCalibration& calib, SystemOptions options);
+  // Without a vocabulary there is no place recognition: a lost camera starts a new map segment.
+  System(const StereoCalibration& calib, SystemOptions options,
+         std::shared_ptr<const place::Vocabulary> vocabulary = nullptr);
   ~System();
   System(const System&) = delete;
   System& operator=(const System&) = delete;
@@ -59,12 +66,15 @@ class System {
   const map::Map& map() const { return map_; }
   const SystemOptions& options() const { return options_; }
   const tracking::Tracker& tracker() const { return *tracker_; }
+  // Null without place recognition.
+  const place::KeyframeDatabase* keyframe_database() const { return database_.get(); }
   mapping::LocalMapperStats mapper_stats() const { return mapper_->stats(); }
 
  private:
   SystemOptions options_;
   map::Map map_;
   tracking::FrameExtractor extractor_;
+  std::unique_ptr<place::KeyframeDatabase> database_;
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<tracking::Tracker> tracker_;
   bool finished_ = false;

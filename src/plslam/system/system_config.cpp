@@ -69,6 +69,34 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
   mapping.get("ba_iterations", o.mapper.ba_iterations);
   mapping.get("culling_redundancy", o.mapper.culling_redundancy);
 
+  const auto place = config.section("place");
+  place.get("enabled", o.place_recognition);
+  std::string vocabulary = o.vocabulary.string();
+  place.get("vocabulary", vocabulary);
+  if (vocabulary != o.vocabulary.string()) {
+    // A relative path in a file is relative to that file's folder, so a config and its vocabulary
+    // can move together.
+    std::filesystem::path v(vocabulary);
+    if (v.is_relative() && !config.source().empty()) v = std::filesystem::path(config.source()).parent_path() / v;
+    o.vocabulary = v;
+  }
+
+  const auto reloc = config.section("relocalization");
+  auto& r = o.tracker.relocalization;
+  reloc.get("enabled", r.enabled);
+  int max_candidates = static_cast<int>(r.max_candidates);
+  reloc.get("max_candidates", max_candidates);
+  if (max_candidates < 1) throw InputError(config.source(), "relocalization.max_candidates: must be >= 1");
+  r.max_candidates = static_cast<std::size_t>(max_candidates);
+  reloc.get("min_bow_matches", r.min_bow_matches);
+  if (r.min_bow_matches < 4) throw InputError(config.source(), "relocalization.min_bow_matches: must be >= 4");
+  reloc.get("min_inliers", r.min_inliers);
+  if (r.min_inliers < 1) throw InputError(config.source(), "relocalization.min_inliers: must be >= 1");
+  reloc.get("search_radius", r.search_radius);
+  if (!(r.search_radius > 0)) throw InputError(config.source(), "relocalization.search_radius: must be positive");
+  reloc.get("new_segment_after_s", r.new_segment_after_s);
+  if (!(r.new_segment_after_s >= 0)) throw InputError(config.source(), "relocalization.new_segment_after_s: must be >= 0");
+
   const auto system = config.section("system");
   int seed = static_cast<int>(o.seed);
   system.get("seed", seed);
@@ -77,6 +105,14 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
 
   config.check_all_used();
   return o;
+}
+
+std::filesystem::path default_vocabulary_path() { return PLSLAM_DEFAULT_VOCABULARY; }
+
+std::shared_ptr<const place::Vocabulary> load_vocabulary(const SystemOptions& o) {
+  if (!o.place_recognition) return nullptr;
+  const auto path = o.vocabulary.empty() ? default_vocabulary_path() : o.vocabulary;
+  return std::make_shared<const place::Vocabulary>(place::Vocabulary::load(path));
 }
 
 SystemOptions load_system_options(io::DatasetFormat format, const std::optional<std::filesystem::path>& file) {

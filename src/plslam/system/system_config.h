@@ -10,17 +10,28 @@
 //              velocity_min_frames}
 //   optim:    {line_information}
 //   mapping:  {local_ba, ba_iterations, culling_redundancy}
+//   place:    {enabled, vocabulary (relative to the config file)}
+//   relocalization: {enabled, max_candidates, min_bow_matches, min_inliers, search_radius,
+//              new_segment_after_s}
 //   system:   {seed}
 #include <filesystem>
+#include <memory>
 #include <optional>
 
 #include "plslam/core/config_reader.h"
+#include "plslam/place/vocabulary.h"
 #include "plslam/system/slam_system.h"
 
 namespace plslam::system {
 
 // Applies `config` on top of `preset`, validates, and fails on unknown keys.
 SystemOptions apply_config(const ConfigReader& config, SystemOptions preset);
+
+// The vocabulary plslam ships (data/vocabulary/, see README: place recognition).
+std::filesystem::path default_vocabulary_path();
+// The vocabulary the options ask for (null with place recognition off); InputError naming the
+// file when it is missing, truncated or not a vocabulary.
+std::shared_ptr<const place::Vocabulary> load_vocabulary(const SystemOptions& options);
 
 // The preset for a dataset format, overridden by the file when given.
 SystemOptions load_system_options(io::DatasetFormat format, const std::optional<std::filesystem::path>& file);

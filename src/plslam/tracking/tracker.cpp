@@ -66,16 +66,31 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   std::unique_lock map_lock(map_.update_mutex());
 
   bool ok = false;
-  if (state_ == TrackingState::kNotInitialized || state_ == TrackingState::kLost) {
-    if (state_ == TrackingState::kLost && last_) {
-      // A new map segment starts where the motion model puts the camera, so the trajectory stays
-      // continuous across the loss.
-      f.T_cw = predicted_pose(f);
-    }
+  auto clear_matches = [&f] {
+    std::fill(f.points.begin(), f.points.end(), nullptr);
+    std::fill(f.lines.begin(), f.lines.end(), nullptr);
+  };
+  if (state_ == TrackingState::kNotInitialized) {
     ok = initialize(f);
     if (ok) {
       result.keyframe = true;
       state_ = TrackingState::kOk;
+    }
+  } else if (state_ == TrackingState::kLost) {
+    ok = relocalize_and_track(f, result);
+    if (!ok) {
+      clear_matches();
+      // A new map segment starts where the motion model puts the camera, so the trajectory stays
+      // continuous across the loss.
+      f.T_cw = predicted_pose(f);
+      if (should_start_new_segment(f) && initialize(f)) {
+        ok = true;
+        result.keyframe = true;
+        result.new_map_segment = true;
+        state_ = TrackingState::kOk;
+        lost_since_.reset();
+        new_segment_frames_.push_back(f.id());
+      }
     }
   } else {
     bool tracked = false;
@@ -88,27 +103,23 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       ok = true;
       velocity_ = (f.T_cw * last_->T_cw.inverse()).normalized();
       velocity_dt_ = f.data->timestamp - last_->data->timestamp;
-      const auto inputs = keyframe_inputs(f, result.point_inliers, result.line_inliers);
-      result.decision = policy_.decide(inputs);
-      result.keyframe_inputs = inputs;
-      result.local_keyframes = static_cast<int>(local_keyframes_.size());
-      result.local_points = static_cast<int>(local_points_.size());
-      result.local_lines = static_cast<int>(local_lines_.size());
-      if (result.decision.insert) {
-        create_keyframe(f);
-        policy_.keyframe_inserted(inputs);
-        result.keyframe = true;
-      }
-      f.discard_outliers();
+      finish_tracked_frame(f, result);
     } else {
       ++lost_events_;
-      spdlog::warn("frame {}: tracking lost (event {}), starting a new map segment", f.id(), lost_events_);
+      const bool relocalizing = database_ && options_.relocalization.enabled;
+      spdlog::warn("frame {}: tracking lost (event {}), {}", f.id(), lost_events_,
+                   relocalizing ? "relocalizing" : "starting a new map segment");
       state_ = TrackingState::kLost;
-      // The motion model's prediction: where a new map segment will start. It is not a tracked
-      // pose (the record says so), and the trajectory outputs never present it as one.
-      f.T_cw = predicted_pose(f);
-      std::fill(f.points.begin(), f.points.end(), nullptr);
-      std::fill(f.lines.begin(), f.lines.end(), nullptr);
+      lost_since_.reset();
+      // The frame that lost track is the first chance to find the camera again.
+      ok = relocalizing && relocalize_and_track(f, result);
+      if (!ok && can_start_map(f)) lost_since_ = f.data->timestamp;  // the relocalization timeout starts
+      if (!ok) {
+        // The motion model's prediction: where a new map segment would start. It is not a tracked
+        // pose (the record says so), and the trajectory outputs never present it as one.
+        f.T_cw = predicted_pose(f);
+        clear_matches();
+      }
     }
   }
 
@@ -126,11 +137,57 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   return result;
 }
 
+bool Tracker::relocalize_and_track(Frame& f, TrackResult& result) {
+  long against = -1;
+  if (!relocalize(f, result.times, against) ||
+      !track_local_map(f, result.times, result.point_inliers, result.line_inliers)) {
+    return false;
+  }
+  state_ = TrackingState::kOk;
+  result.relocalized = true;
+  result.relocalized_against = against;
+  relocalized_frames_.push_back(f.id());
+  lost_since_.reset();
+  // The frames since the loss carry predictions, not poses: no velocity across them.
+  velocity_.reset();
+  spdlog::info("frame {}: relocalized against keyframe {} ({} point and {} line inliers)", f.id(), against,
+               result.point_inliers, result.line_inliers);
+  finish_tracked_frame(f, result);
+  return true;
+}
+
+void Tracker::finish_tracked_frame(Frame& f, TrackResult& result) {
+  const auto inputs = keyframe_inputs(f, result.point_inliers, result.line_inliers);
+  result.decision = policy_.decide(inputs);
+  result.keyframe_inputs = inputs;
+  result.local_keyframes = static_cast<int>(local_keyframes_.size());
+  result.local_points = static_cast<int>(local_points_.size());
+  result.local_lines = static_cast<int>(local_lines_.size());
+  if (result.decision.insert) {
+    create_keyframe(f);
+    policy_.keyframe_inserted(inputs);
+    result.keyframe = true;
+  }
+  f.discard_outliers();
+}
+
+bool Tracker::can_start_map(const Frame& f) const {
+  int stereo = 0;
+  for (float z : f.data->depth) stereo += z > 0;
+  return stereo >= options_.init_min_points;
+}
+
+bool Tracker::should_start_new_segment(const Frame& f) {
+  if (!database_ || !options_.relocalization.enabled) return true;
+  if (!can_start_map(f)) return false;  // could not start one anyway
+  if (!lost_since_) lost_since_ = f.data->timestamp;
+  // (1 us of slack: 10 frames at 10 Hz are 0.99999... s apart in floating point)
+  return f.data->timestamp - *lost_since_ >= options_.relocalization.new_segment_after_s - 1e-6;
+}
+
 bool Tracker::initialize(Frame& f) {
   const auto& d = *f.data;
-  int stereo = 0;
-  for (float z : d.depth) stereo += z > 0;
-  if (stereo < options_.init_min_points) return false;
+  if (!can_start_map(f)) return false;
   map::KeyFrame* kf = map_.create_keyframe(f.data, f.T_cw);
   for (std::size_t i = 0; i < d.keypoints.size(); ++i) {
     if (d.depth[i] > 0) create_stereo_point(f, kf, i);

@@ -3,6 +3,7 @@
 // initialisation, constant-velocity motion model with projection search, fall-back to the
 // reference keyframe, local map tracking, pose-only optimisation over points and lines, the
 // keyframe decision (PID + Kalman), and keyframe creation with new stereo points and lines.
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -15,7 +16,26 @@
 #include "plslam/tracking/keyframe_policy.h"
 #include "plslam/tracking/projection_search.h"
 
+namespace plslam::place {
+class KeyframeDatabase;
+}  // namespace plslam::place
+
 namespace plslam::tracking {
+
+// Relocalization while LOST (ORB-SLAM2's Relocalization, with lines): keyframes that look like the
+// frame (keyframe database), BoW matching, PnP RANSAC, pose optimisation over points and lines,
+// search by projection, and an inlier threshold.
+struct RelocalizationOptions {
+  bool enabled = true;             // also needs a keyframe database (a vocabulary)
+  std::size_t max_candidates = 10; // keyframes tried per frame, best place first
+  int min_bow_matches = 15;        // BoW matches a candidate needs before PnP
+  int min_pnp_inliers = 10;
+  double search_radius = 3.0;      // factor of the local-map search window, around the PnP pose
+  int min_inliers = 50;            // point + line inliers to accept (ORB-SLAM2: 50 points)
+  // A camera that stays lost this long on frames that could start a map (seconds of textured
+  // frames, so a black-out does not count) starts a new map segment instead.
+  double new_segment_after_s = 1.0;
+};
 
 struct TrackerOptions {
   int init_min_points = 500;          // stereo points needed to start a map
@@ -40,6 +60,8 @@ struct TrackerOptions {
   optim::PoseOnlyOptions pose;
   KeyframePolicyOptions keyframe;
   int local_keyframes_max = 80;
+  RelocalizationOptions relocalization;
+  std::uint32_t seed = 1;  // of the relocalization's PnP RANSAC (SystemOptions::seed)
 };
 
 enum class TrackingState { kNotInitialized, kOk, kLost };
@@ -57,6 +79,9 @@ struct TrackResult {
   int point_inliers = 0;
   int line_inliers = 0;
   bool keyframe = false;
+  bool relocalized = false;      // tracked again in the same map after being lost
+  bool new_map_segment = false;  // a lost camera started a new, disconnected map segment
+  long relocalized_against = -1; // the keyframe (id) relocalization matched
   KeyframeDecision decision;
   KeyframeInputs keyframe_inputs;  // what the decision saw (tracked frames only)
   int local_keyframes = 0, local_points = 0, local_lines = 0;  // the local map tracked against
@@ -81,9 +106,14 @@ class Tracker {
           std::function<bool()> mapping_idle);
 
   TrackResult track(std::shared_ptr<const map::FrameData> data);
+  // Place recognition for relocalization; without one, a lost camera starts a new map segment on
+  // the next frame that can. Not owned; must outlive the tracker.
+  void set_keyframe_database(const place::KeyframeDatabase* database) { database_ = database; }
 
   TrackingState state() const { return state_; }
   int lost_events() const { return lost_events_; }
+  const std::vector<long>& relocalized_frames() const { return relocalized_frames_; }
+  const std::vector<long>& new_segment_frames() const { return new_segment_frames_; }
   const std::vector<FrameRecord>& records() const { return records_; }
   // The pose of a record with every keyframe's current estimate (call with local mapping idle).
   static geometry::SE3 pose_of(const FrameRecord& r);
@@ -96,6 +126,18 @@ class Tracker {
   std::optional<geometry::SE3> pnp_from_matches(const Frame& f) const;
   bool track_reference_keyframe(Frame& f, TrackStageTimes& t);
   bool track_local_map(Frame& f, TrackStageTimes& t, int& point_inliers, int& line_inliers);
+  // Relocalization (see RelocalizationOptions); on success `f` holds the pose and matches and
+  // the candidate keyframe becomes the reference. Defined in tracker_relocalization.cpp.
+  bool relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id);
+  // Relocalization, then local map tracking and the keyframe decision; true when both succeed.
+  bool relocalize_and_track(Frame& f, TrackResult& result);
+  // While lost: whether this frame should start a new map segment instead of waiting for
+  // relocalization.
+  bool should_start_new_segment(const Frame& f);
+  // Whether the frame has the stereo points to start a map (init_min_points).
+  bool can_start_map(const Frame& f) const;
+  // The keyframe decision and bookkeeping of a tracked frame.
+  void finish_tracked_frame(Frame& f, TrackResult& result);
   int optimize_pose(Frame& f, TrackStageTimes& t);
   void update_local_map(Frame& f);
   map::KeyFrame* create_keyframe(Frame& f);
@@ -124,6 +166,10 @@ class Tracker {
   std::vector<map::MapLine*> local_lines_;
   std::vector<FrameRecord> records_;
   int lost_events_ = 0;
+  const place::KeyframeDatabase* database_ = nullptr;
+  std::optional<double> lost_since_;  // first textured frame that failed to relocalize
+  std::vector<long> relocalized_frames_;
+  std::vector<long> new_segment_frames_;
 };
 
 }  // namespace plslam::tracking

@@ -1,0 +1,93 @@
+// Tracker::relocalize: finding the camera again in the map it was lost in.
+#include <unordered_set>
+
+#include "plslam/core/stopwatch.h"
+#include "plslam/geometry/pnp.h"
+#include "plslam/map/keyframe.h"
+#include "plslam/map/map_line.h"
+#include "plslam/map/map_point.h"
+#include "plslam/place/bow_matching.h"
+#include "plslam/place/keyframe_database.h"
+#include "plslam/tracking/tracker.h"
+
+namespace plslam::tracking {
+
+bool Tracker::relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id) {
+  const auto& o = options_.relocalization;
+  if (!o.enabled || !database_ || f.data->keypoints.empty()) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto place = database_->describe(f.data->descriptors);
+  place::DatabaseQueryOptions q;
+  q.max_candidates = o.max_candidates;
+  const auto candidates = database_->query(place.bow, q);
+  const place::BowImage query{&f.data->descriptors, &place.features, &f.data->keypoints};
+  const geometry::StereoCamera cam(f.data->calib);
+  bool found = false;
+  for (const auto& c : candidates) {
+    map::KeyFrame* kf = c.keyframe;
+    const auto kf_place = database_->description(kf);
+    if (!kf_place || kf->is_bad()) continue;
+    // 1. BoW matches to the keyframe's map points.
+    const auto kf_points = kf->map_points();
+    const place::BowImage train{&kf->data().descriptors, &kf_place->features, &kf->data().keypoints};
+    const auto matches = place::match_by_bow(query, train, [&](int i) {
+      const map::MapPoint* mp = kf_points[static_cast<std::size_t>(i)];
+      return mp && !mp->is_bad();
+    });
+    if (static_cast<int>(matches.size()) < o.min_bow_matches) continue;
+    // 2. PnP RANSAC on them.
+    std::vector<Eigen::Vector3d> world;
+    std::vector<Eigen::Vector2d> pixels;
+    for (const auto& m : matches) {
+      world.push_back(kf_points[static_cast<std::size_t>(m.train)]->position());
+      const auto& pt = f.data->keypoints[static_cast<std::size_t>(m.query)].pt;
+      pixels.emplace_back(pt.x, pt.y);
+    }
+    geometry::PnpOptions pnp;
+    pnp.min_inliers = o.min_pnp_inliers;
+    pnp.seed = options_.seed;
+    const auto r = geometry::solve_pnp_ransac(cam, world, pixels, pnp);
+    if (!r.success) continue;
+    // 3. Pose optimisation over the PnP inliers.
+    Frame c_frame(f.data);
+    c_frame.T_cw = r.T_cw;
+    for (int i : r.inliers) {
+      const auto& m = matches[static_cast<std::size_t>(i)];
+      c_frame.points[static_cast<std::size_t>(m.query)] = kf_points[static_cast<std::size_t>(m.train)];
+    }
+    if (optimize_pose(c_frame, t) < o.min_pnp_inliers) continue;
+    c_frame.discard_outliers();
+    // 4. Search by projection: the points and lines of the keyframe and its best covisibles.
+    std::vector<map::MapPoint*> points;
+    std::vector<map::MapLine*> lines;
+    std::unordered_set<const void*> seen;
+    auto neighbourhood = kf->best_covisibles(10);
+    neighbourhood.insert(neighbourhood.begin(), kf);
+    for (map::KeyFrame* k : neighbourhood) {
+      if (k->is_bad()) continue;
+      for (map::MapPoint* mp : k->map_points()) {
+        if (mp && !mp->is_bad() && seen.insert(mp).second) points.push_back(mp);
+      }
+      if (!options_.lines) continue;
+      for (map::MapLine* ml : k->map_lines()) {
+        if (ml && !ml->is_bad() && seen.insert(ml).second) lines.push_back(ml);
+      }
+    }
+    search_points_in_local_map(c_frame, points, o.search_radius * options_.local_map_radius, options_.search);
+    if (options_.lines) search_lines(c_frame, lines, options_.line_radius, options_.search);
+    // 5. Optimise again over points and lines; accept above the threshold.
+    const int inliers = optimize_pose(c_frame, t);
+    c_frame.discard_outliers();
+    if (inliers < o.min_inliers) continue;
+    c_frame.reference = kf;
+    reference_ = kf;
+    keyframe_id = kf->id();
+    f = std::move(c_frame);
+    found = true;
+    break;
+  }
+  t.track_motion_ms += ms_since(t0);
+  return found;
+}
+
+}  // namespace plslam::tracking

@@ -1,0 +1,169 @@
+// Relocalization on real images (issue 14): the KITTI 06 excerpt replayed as a kidnapped robot
+// (frames 0-50, 20 black frames, then frames 10-50 again: the camera reappears 50 m back), and
+// the fallbacks: without place recognition, and when relocalization keeps failing, a new map
+// segment; a bad vocabulary file is refused before the first frame.
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "plslam/eval/alignment.h"
+#include "plslam/eval/ape.h"
+#include "plslam/io/trajectory_io.h"
+#include "robustness/kitti_copies.h"
+#include "support/test_support.h"
+
+namespace plslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr long kTextureReturns = 71;  // first frame of the replay
+
+// Frames 0..last, 20 black frames, then frames 10..last again, at 10 Hz. (With a shorter first
+// pass, 0-30 then 10-30, the camera is not lost: the reference keyframe's far points still
+// place it.)
+fs::path kidnapped_copy(const fs::path& data, const fs::path& root, int last = 50) {
+  auto frames = test::range(0, last + 1);
+  for (int i = 0; i < 20; ++i) frames.push_back(-1);
+  for (int i = 10; i <= last; ++i) frames.push_back(i);
+  return test::make_copy(data, root, frames, {}, "06", /*times_at_10hz=*/true);
+}
+
+
+// Position error of every tracked frame (by input index) after the se3 alignment of the run.
+std::map<std::size_t, double> errors_by_frame(const test::Run& r, const fs::path& gt_file) {
+  const auto est = io::read_trajectory(r.out / "trajectory.kitti", io::TrajectoryFormat::kKitti);
+  const auto gt = io::read_trajectory(gt_file, io::TrajectoryFormat::kKitti);
+  const auto untracked = r.stats["untracked_kitti_lines"].get<std::vector<std::size_t>>();
+  EXPECT_EQ(est.size(), gt.size());
+  Trajectory e, g;
+  std::vector<std::size_t> index;
+  for (std::size_t i = 0; i < std::min(est.size(), gt.size()); ++i) {
+    if (std::find(untracked.begin(), untracked.end(), i) != untracked.end()) continue;
+    e.push_back(est[i]);
+    g.push_back(gt[i]);
+    index.push_back(i);
+  }
+  const auto aligned = eval::apply_alignment(e, eval::solve_alignment(g, e, eval::AlignMode::kSE3));
+  const auto err = eval::ape_translation(g, aligned);
+  std::map<std::size_t, double> out;
+  for (std::size_t k = 0; k < index.size(); ++k) out[index[k]] = err[k];
+  return out;
+}
+
+TEST(Relocalization, KidnappedKittiCameraIsFoundAgainInTheSameMap) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto seq = kidnapped_copy(data, tmp.path() / "d");
+  const auto r = test::run(seq, tmp.path() / "out");
+  ASSERT_EQ(r.cli.exit_code, 0) << r.cli.err;
+  EXPECT_EQ(r.stats["skipped_frames"], 20);  // the black frames, reported
+  EXPECT_EQ(r.stats["new_map_segments"]["count"], 0);
+  const auto reloc = r.stats["relocalizations"]["frames"].get<std::vector<long>>();
+  ASSERT_EQ(reloc.size(), 1u) << r.stats.dump(2);
+  // Within 3 frames of texture returning.
+  EXPECT_GE(reloc.front(), kTextureReturns);
+  EXPECT_LT(reloc.front(), kTextureReturns + 3);
+  EXPECT_EQ(r.stats["place_recognition"]["enabled"], true);
+  EXPECT_GT(r.stats["place_recognition"]["database_keyframes"].get<int>(), 5);
+  // Every replayed frame from the relocalization on is where the ground truth says, in the
+  // world frame of the first pass.
+  const auto errors = errors_by_frame(r, tmp.path() / "d" / "poses" / "06.txt");
+  std::size_t replayed = 0;
+  for (const auto& [frame, err] : errors) {
+    if (static_cast<long>(frame) < reloc.front()) continue;
+    ++replayed;
+    EXPECT_LT(err, 0.2) << "frame " << frame;
+  }
+  EXPECT_EQ(replayed, static_cast<std::size_t>(kTextureReturns + 41 - reloc.front()));
+  EXPECT_NE(r.cli.out.find("relocalizations 1, new map segments 0"), std::string::npos) << r.cli.out;
+}
+
+// The same in the default concurrent mode: local mapping fills the keyframe database while
+// tracking queries it (this suite also runs under ThreadSanitizer).
+TEST(RelocalizationConcurrent, KidnappedKittiCameraIsFoundAgainWhileLocalMappingRuns) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto seq = kidnapped_copy(data, tmp.path() / "d");
+  const fs::path out = tmp.path() / "out";
+  const auto cli = test::run_cli("run \"" + seq.string() + "\" --out \"" + out.string() + "\" --quiet");
+  ASSERT_EQ(cli.exit_code, 0) << cli.err;
+  const auto stats = nlohmann::json::parse(test::read_file(out / "stats.json"));
+  EXPECT_EQ(stats["mode"], "concurrent");
+  EXPECT_EQ(stats["new_map_segments"]["count"], 0);
+  const auto reloc = stats["relocalizations"]["frames"].get<std::vector<long>>();
+  ASSERT_EQ(reloc.size(), 1u) << stats.dump(2);
+  EXPECT_LT(reloc.front(), kTextureReturns + 3);
+  EXPECT_GE(stats["tracked_frames"].get<int>(), 90);
+}
+
+TEST(Relocalization, WithoutPlaceRecognitionALostCameraStartsANewSegment) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto seq = kidnapped_copy(data, tmp.path() / "d");
+  const auto r = test::run(seq, tmp.path() / "out", "--no-place-recognition");
+  ASSERT_EQ(r.cli.exit_code, 0) << r.cli.err;
+  EXPECT_EQ(r.stats["relocalizations"]["count"], 0);
+  EXPECT_EQ(r.stats["new_map_segments"]["frames"], nlohmann::json::array({kTextureReturns + 1}));
+  EXPECT_EQ(r.stats["place_recognition"]["enabled"], false);
+}
+
+TEST(Relocalization, KeepsFailingForOneSecondThenStartsANewSegment) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto seq = kidnapped_copy(data, tmp.path() / "d");
+  // An unreachable inlier threshold: relocalization can never succeed.
+  {
+    std::ofstream c(tmp.path() / "c.yaml");
+    c << "relocalization:\n  min_inliers: 100000\n  new_segment_after_s: 1.0\n";
+  }
+  const auto r = test::run(seq, tmp.path() / "out", "--config \"" + (tmp.path() / "c.yaml").string() + "\"");
+  ASSERT_EQ(r.cli.exit_code, 0) << r.cli.err;
+  EXPECT_EQ(r.stats["relocalizations"]["count"], 0);
+  // Lost at 71; the textured frames 71-80 try to relocalize, frame 81 (1 s later) starts a segment.
+  EXPECT_EQ(r.stats["new_map_segments"]["frames"], nlohmann::json::array({kTextureReturns + 10}));
+  const auto lost = r.stats["lost_frame_ids"].get<std::vector<long>>();
+  ASSERT_EQ(lost.size(), 10u);
+  EXPECT_EQ(lost.front(), kTextureReturns);
+  EXPECT_EQ(lost.back(), kTextureReturns + 9);
+}
+
+TEST(Relocalization, BadVocabularyFilesAreRefusedBeforeTheFirstFrame) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const fs::path seq = data / "kitti" / "sequences" / "06";
+  const std::string good = test::read_file(fs::path(PLSLAM_SOURCE_DIR) / "data" / "vocabulary" / "plslam_orb_k10_l4.plvoc");
+  ASSERT_GT(good.size(), 1000u);
+  {
+    std::ofstream(tmp.path() / "truncated.plvoc", std::ios::binary).write(good.data(), 500);
+    std::ofstream(tmp.path() / "foreign.plvoc") << "# ORB-SLAM2 vocabulary\n10 6 0 0\n";
+  }
+  for (const std::string name : {"missing.plvoc", "truncated.plvoc", "foreign.plvoc"}) {
+    const fs::path file = tmp.path() / name;
+    const auto r = test::run_cli("run \"" + seq.string() + "\" --out \"" + (tmp.path() / ("out-" + name)).string() +
+                                 "\" --quiet --vocabulary \"" + file.string() + "\"");
+    EXPECT_EQ(r.exit_code, 2) << name;
+    EXPECT_NE(r.err.find(file.string()), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(tmp.path() / ("out-" + name) / "stats.json"));
+  }
+}
+
+TEST(Relocalization, VocabInfoPrintsTheDefaultVocabularysParameters) {
+  const fs::path file = fs::path(PLSLAM_SOURCE_DIR) / "data" / "vocabulary" / "plslam_orb_k10_l4.plvoc";
+  const auto text = test::run_cli("vocab info \"" + file.string() + "\"");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("k = 10, L = 4"), std::string::npos) << text.out;
+  const auto json = test::run_cli("vocab info \"" + file.string() + "\" --json");
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const auto j = nlohmann::json::parse(json.out);
+  EXPECT_EQ(j["k"], 10);
+  EXPECT_EQ(j["levels"], 4);
+  EXPECT_GT(j["words"].get<int>(), 5000);
+  EXPECT_LT(j["bytes"].get<double>(), 10e6);
+  EXPECT_EQ(test::run_cli("vocab info \"" + (file.string() + ".missing") + "\"").exit_code, 2);
+}
+
+}  // namespace
+}  // namespace plslam
