@@ -25,7 +25,7 @@ std::vector<LoopDetection> LoopDetector::detect(map::KeyFrame* kf) {
   }
   // The neighbourhood: the keyframe and everything covisible with it. The least similar neighbour
   // sets the bar a distant keyframe must reach.
-  map::IdSet<map::KeyFrame> neighbourhood;
+  map::IdSet<const map::KeyFrame> neighbourhood;
   neighbourhood.insert(kf);
   double min_score = 1.0;
   bool any = false;
@@ -43,7 +43,7 @@ std::vector<LoopDetection> LoopDetector::detect(map::KeyFrame* kf) {
   place::DatabaseQueryOptions q;
   q.min_score = min_score;
   q.group_size = options_.group_size;
-  q.exclude = [&](const map::KeyFrame* k) { return neighbourhood.count(const_cast<map::KeyFrame*>(k)) > 0; };
+  q.exclude = [&](const map::KeyFrame* k) { return neighbourhood.count(k) > 0; };
   const auto candidates = database_.query(description->bow, q);
 
   // Consistency: a candidate's place (it and its covisibles) continues a place the previous

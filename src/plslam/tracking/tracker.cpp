@@ -106,7 +106,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       finish_tracked_frame(f, result);
     } else {
       ++lost_events_;
-      const bool relocalizing = database_ && options_.relocalization.enabled;
+      const bool relocalizing = relocalization_on();
       spdlog::warn("frame {}: tracking lost (event {}), {}", f.id(), lost_events_,
                    relocalizing ? "relocalizing" : "starting a new map segment");
       state_ = TrackingState::kLost;
@@ -178,7 +178,7 @@ bool Tracker::can_start_map(const Frame& f) const {
 }
 
 bool Tracker::should_start_new_segment(const Frame& f) {
-  if (!database_ || !options_.relocalization.enabled) return true;
+  if (!relocalization_on()) return true;
   if (!can_start_map(f)) return false;  // could not start one anyway
   if (!lost_since_) lost_since_ = f.data->timestamp;
   // (1 us of slack: 10 frames at 10 Hz are 0.99999... s apart in floating point)

@@ -134,6 +134,8 @@ class Tracker {
   // While lost: whether this frame should start a new map segment instead of waiting for
   // relocalization.
   bool should_start_new_segment(const Frame& f);
+  // Relocalization is on: enabled and a keyframe database to query.
+  bool relocalization_on() const { return database_ && options_.relocalization.enabled; }
   // Whether the frame has the stereo points to start a map (init_min_points).
   bool can_start_map(const Frame& f) const;
   // The keyframe decision and bookkeeping of a tracked frame.

@@ -14,7 +14,7 @@ namespace plslam::tracking {
 
 bool Tracker::relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id) {
   const auto& o = options_.relocalization;
-  if (!o.enabled || !database_ || f.data->keypoints.empty()) return false;
+  if (!relocalization_on() || f.data->keypoints.empty()) return false;
   const auto t0 = std::chrono::steady_clock::now();
   const auto place = database_->describe(f.data->descriptors);
   place::DatabaseQueryOptions q;
