@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "plslam/map/descriptor_utils.h"
+#include "plslam/geometry/stereo_camera.h"
 #include "plslam/map/map.h"
 
 namespace plslam::map {
@@ -222,6 +223,60 @@ TEST(FrameData, LevelScalesArePowersOfTheScaleFactor) {
     EXPECT_NEAR(d.level_scale(l), std::pow(1.2, l), 1e-12);
     EXPECT_NEAR(d.level_sigma2(l), std::pow(1.2, 2 * l), 1e-12);
   }
+}
+
+}  // namespace
+}  // namespace plslam::map
+
+namespace plslam::map {
+namespace {
+
+// Three keyframes see a 2 m 3D segment from different places, each a different part of it.
+// Collapsed onto a point of the line (what BA used to leave), the line gets its direction back
+// from the observed planes and its extent from the observed segments.
+TEST(MapLine, RefitRecoversDirectionAndExtentFromTheObservations) {
+  const Eigen::Vector3d A(-1.0, 0.3, 6.0), B(1.0, -0.2, 7.0);  // the true segment, world frame
+  Map map;
+  std::vector<KeyFrame*> kfs;
+  const std::vector<Eigen::Vector3d> centres = {{0, 0, 0}, {0.8, 0.1, 0.5}, {-0.6, -0.4, 0.2}};
+  const std::vector<std::pair<double, double>> parts = {{0.0, 0.7}, {0.2, 1.0}, {0.1, 0.9}};
+  for (std::size_t k = 0; k < centres.size(); ++k) {
+    auto d = make_data(static_cast<long>(k), 1, 1);
+    const geometry::SE3 T_cw(Eigen::AngleAxisd(0.05 * static_cast<double>(k), Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                             Eigen::Vector3d::Zero());
+    const geometry::SE3 T(T_cw.rotation(), -(T_cw.rotation() * centres[k]));
+    const geometry::StereoCamera cam(d->calib);
+    const Eigen::Vector2d s = cam.project(T * (A + parts[k].first * (B - A)));
+    const Eigen::Vector2d e = cam.project(T * (A + parts[k].second * (B - A)));
+    auto& o = d->lines[0];
+    o.segment.start = cv::Point2f(static_cast<float>(s.x()), static_cast<float>(s.y()));
+    o.segment.end = cv::Point2f(static_cast<float>(e.x()), static_cast<float>(e.y()));
+    o.left_line = geometry::line_through(s, e);
+    const Eigen::Vector3d sr = cam.project_stereo(T * (A + parts[k].first * (B - A)));
+    const Eigen::Vector3d er = cam.project_stereo(T * (A + parts[k].second * (B - A)));
+    o.right_line = geometry::line_through({sr.z(), sr.y()}, {er.z(), er.y()});
+    o.stereo = true;
+    kfs.push_back(map.create_keyframe(d, T));
+  }
+  const Eigen::Vector3d on_line = A + 0.4 * (B - A);
+  MapLine* ml = map.create_line(on_line, on_line, kfs[0], 0);
+  for (std::size_t k = 0; k < kfs.size(); ++k) {
+    ml->add_observation(kfs[k], 0);
+    kfs[k]->add_map_line(ml, 0);
+  }
+  ASSERT_TRUE(ml->refit_to_observations());
+  // The union of the observed parts: the whole segment, up to float pixel rounding.
+  const bool forward = (ml->end() - ml->start()).dot(B - A) > 0;
+  EXPECT_LT(((forward ? ml->start() : ml->end()) - A).norm(), 1e-3);
+  EXPECT_LT(((forward ? ml->end() : ml->start()) - B).norm(), 1e-3);
+  // A line that keeps its direction is only re-clipped: a too short one grows to the extent seen.
+  ml->set_endpoints(A + 0.45 * (B - A), A + 0.55 * (B - A));
+  ASSERT_TRUE(ml->refit_to_observations());
+  EXPECT_LT((ml->start() - A).norm(), 1e-3);
+  EXPECT_LT((ml->end() - B).norm(), 1e-3);
+  // A collapsed line without observations has nothing to be refitted from.
+  MapLine* lone = map.create_line(on_line, on_line, kfs[0], 0);
+  EXPECT_FALSE(lone->refit_to_observations());
 }
 
 }  // namespace

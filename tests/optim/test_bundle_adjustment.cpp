@@ -261,6 +261,8 @@ TEST(BundleAdjustment, BackendsAgreeOnNoisyProblem) {
   test::perturb(&scene.problem, 0.02, 0.005, 0.02, rng);
   BaOptions opt;
   opt.iterations = 50;
+  // To convergence: the lines' endpoints move only across the lines, a slower valley for both.
+  opt.function_tolerance = 1e-12;
   opt.backend = BaBackend::kSchurLM;
   const BaResult a = bundle_adjust(cam, scene.problem, opt);
   opt.backend = BaBackend::kCeres;
@@ -281,6 +283,36 @@ TEST(BundleAdjustment, BackendsAgreeOnNoisyProblem) {
   EXPECT_LT(point_diff, 1e-4);
   EXPECT_EQ(a.point_observation_outlier, b.point_observation_outlier);
   EXPECT_EQ(a.line_observation_outlier, b.line_observation_outlier);
+}
+
+TEST(BundleAdjustment, LineEndpointsMoveOnlyAcrossTheLine) {
+  // Along its 3D line an endpoint is unobservable: with noisy observed lines both endpoints used
+  // to drift onto the one point that fits the planes best, and segments collapsed to length 0.
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(8);
+  auto scene = test::make_ba_scene(cam, 8, 200, 60, rng);
+  scene.problem.keyframes[0].fixed = true;
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (auto& o : scene.problem.line_observations) {
+    o.left_line(2) += noise(rng);
+    o.right_line(2) += noise(rng);
+  }
+  test::perturb(&scene.problem, 0.02, 0.005, 0.02, rng);
+  for (const auto backend : {BaBackend::kSchurLM, BaBackend::kCeres}) {
+    BaOptions opt;
+    opt.iterations = 50;
+    opt.function_tolerance = 1e-12;
+    opt.backend = backend;
+    const BaResult r = bundle_adjust(cam, scene.problem, opt);
+    ASSERT_TRUE(r.usable) << r.message;
+    for (std::size_t l = 0; l < r.lines.size(); ++l) {
+      const auto& in = scene.problem.lines[l];
+      const Eigen::Vector3d d = (in.end - in.start).normalized();
+      EXPECT_NEAR(d.dot(r.lines[l].start - in.start), 0.0, 1e-6) << "line " << l;
+      EXPECT_NEAR(d.dot(r.lines[l].end - in.end), 0.0, 1e-6) << "line " << l;
+      EXPECT_GT((r.lines[l].end - r.lines[l].start).norm(), 0.9 * (in.end - in.start).norm()) << "line " << l;
+    }
+  }
 }
 
 // Threads only split the sums: the result matches the single-thread one to rounding.

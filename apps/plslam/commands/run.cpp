@@ -46,6 +46,7 @@ struct RunArgs {
   std::string config;
   std::string vocabulary;
   bool no_place_recognition = false;
+  bool no_loop_closing = false;
   bool no_lines = false;
   bool quiet = false;
   bool realtime = false;
@@ -64,6 +65,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   options.sequential = args.sequential;
   if (!args.vocabulary.empty()) options.vocabulary = args.vocabulary;
   if (args.no_place_recognition) options.place_recognition = false;
+  if (args.no_loop_closing) options.loop_closing = false;
   const auto vocabulary = system::load_vocabulary(options);  // InputError naming the file
 
   spdlog::info("{}: {} frames, {}x{}, {:.1f} fps, baseline {:.3f} m, lines {}, place recognition {}", ds->root().string(),
@@ -102,9 +104,9 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
       if (!args.quiet && (now - last_progress > std::chrono::seconds(1) || done == ds->size())) {
         last_progress = now;
         const double elapsed = std::chrono::duration<double>(now - start).count();
-        spdlog::info("frame {}/{}  {:.1f} fps  {}  KF {}  MP {}  ML {}", done, ds->size(), done / elapsed,
+        spdlog::info("frame {}/{}  {:.1f} fps  {}  KF {}  MP {}  ML {}  loops {}", done, ds->size(), done / elapsed,
                      tracking::to_string(r.track.state), slam.map().num_keyframes(), slam.map().num_points(),
-                     slam.map().num_lines());
+                     slam.map().num_lines(), slam.loop_closer() ? slam.loop_closer()->stats().loops.size() : 0);
       }
     }
   } catch (const InputError& e) {
@@ -223,11 +225,13 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                                           "Vocabulary file for place recognition (default: the one in data/vocabulary)");
                            sub.add_flag("--no-place-recognition", args->no_place_recognition,
                                         "No relocalization: a lost camera starts a new map segment");
+                           sub.add_flag("--no-loop-closing", args->no_loop_closing,
+                                        "No loop closing (odometry with local mapping only)");
                            sub.add_flag("--no-lines", args->no_lines, "Points only");
                            sub.add_flag("--quiet", args->quiet, "No progress lines");
                            sub.add_flag("--realtime", args->realtime, "Pace the input at the dataset's frame rate");
                            sub.add_flag("--sequential", args->sequential,
-                                        "Run local mapping in the tracking thread (reproducible runs)");
+                                        "Run local mapping and loop closing in the tracking thread (reproducible runs)");
                            sub.add_option("--repeat", args->repeat,
                                           "Run N times into DIR/run-1..N and report the ATE's median, min and max")
                                ->check(CLI::Range(1, 1000));

@@ -122,6 +122,7 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
   out.candidate = candidate;
   out.T_query_candidate = T;
   for (std::size_t i : best) out.matches.emplace_back(pairs[i].query_point, pairs[i].candidate_point);
+  out.inliers = static_cast<int>(out.matches.size());
   return out;
 }
 

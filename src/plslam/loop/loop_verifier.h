@@ -38,6 +38,7 @@ struct LoopConstraint {
   geometry::SE3 T_query_candidate;  // the candidate's camera frame into the query's
   // Query keyframe's map points matched to the candidate's, inliers of the transform.
   std::vector<std::pair<map::MapPoint*, map::MapPoint*>> matches;
+  int inliers = 0;  // matches.size() here; loop closing's projection check raises it
 };
 
 // The constraint when the candidate passes; nullopt otherwise. Reads map points' positions and the

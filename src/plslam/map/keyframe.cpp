@@ -221,6 +221,16 @@ geometry::SE3 KeyFrame::pose_relative_to_parent() const {
   return T_cp_;
 }
 
+void KeyFrame::add_loop_edge(KeyFrame* kf) {
+  std::lock_guard lock(graph_mutex_);
+  loop_edges_.insert(kf);
+}
+
+IdSet<KeyFrame> KeyFrame::loop_edges() const {
+  std::lock_guard lock(graph_mutex_);
+  return loop_edges_;
+}
+
 void KeyFrame::set_bad() {
   if (id_ == 0) return;
   for (auto* kf : covisibles()) kf->erase_connection(this);

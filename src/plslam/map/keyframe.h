@@ -68,6 +68,11 @@ class KeyFrame {
   void erase_child(KeyFrame* kf);
   void change_parent(KeyFrame* kf);
 
+  // Loop edges: keyframes this one was tied to by a closed loop. They stay in the essential graph
+  // of every later loop, and local mapping never culls a keyframe that has one.
+  void add_loop_edge(KeyFrame* kf);
+  IdSet<KeyFrame> loop_edges() const;
+
   // Never removes the first keyframe. Otherwise: detaches from points, lines and the graph,
   // re-parents its children to their best covisible candidate, and remembers its pose relative
   // to its parent so that frames that referenced it keep a valid pose.
@@ -93,6 +98,7 @@ class KeyFrame {
   std::vector<KeyFrame*> ordered_;  // covisibles by decreasing weight
   KeyFrame* parent_ = nullptr;
   IdSet<KeyFrame> children_;
+  IdSet<KeyFrame> loop_edges_;
   bool first_connection_ = true;
   bool bad_ = false;
   geometry::SE3 T_cp_;

@@ -2,6 +2,7 @@
 // The map: owner of every keyframe, map point and map line. Objects are never freed before the
 // Map itself, so the raw pointers that frames, keyframes and landmarks keep to each other stay
 // valid; culled objects are flagged bad and leave the active sets. Thread-safe.
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -40,10 +41,16 @@ class Map {
   // Held by whoever changes poses or structure wholesale (local BA write-back) and by tracking
   // while it reads them, so that tracking never sees half an update (ORB-SLAM2's mMutexMapUpdate).
   std::mutex& update_mutex() { return update_mutex_; }
+  // Counts wholesale changes of the map's geometry (a loop correction, a global BA merge): every
+  // keyframe may have moved, so whoever keeps a pose across frames (the tracker's last frame)
+  // re-expresses it through its reference keyframe when the count changed.
+  long big_changes() const { return big_changes_.load(); }
+  void note_big_change() { ++big_changes_; }
 
  private:
   mutable std::mutex mutex_;
   std::mutex update_mutex_;
+  std::atomic<long> big_changes_{0};
   std::vector<std::unique_ptr<KeyFrame>> all_keyframes_;
   std::vector<std::unique_ptr<MapPoint>> all_points_;
   std::vector<std::unique_ptr<MapLine>> all_lines_;

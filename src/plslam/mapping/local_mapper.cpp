@@ -17,6 +17,8 @@
 #include "plslam/geometry/triangulation.h"
 #include "plslam/map/descriptor_utils.h"
 #include "plslam/mapping/epipolar_index.h"
+#include "plslam/mapping/keyframe_projection.h"
+#include "plslam/mapping/map_ba_problem.h"
 #include "plslam/place/keyframe_database.h"
 
 namespace plslam::mapping {
@@ -50,6 +52,20 @@ void LocalMapper::insert(map::KeyFrame* kf) {
   {
     std::lock_guard lock(queue_mutex_);
     queue_.push_back(kf);
+  }
+  cv_.notify_all();
+}
+
+void LocalMapper::pause() {
+  std::unique_lock lock(queue_mutex_);
+  ++pauses_;
+  cv_.wait(lock, [this] { return !busy_; });
+}
+
+void LocalMapper::resume() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    --pauses_;
   }
   cv_.notify_all();
 }
@@ -98,8 +114,12 @@ void LocalMapper::process_pending() {
 void LocalMapper::run() {
   std::unique_lock lock(queue_mutex_);
   for (;;) {
-    cv_.wait(lock, [this] { return !queue_.empty() || stop_requested_; });
+    cv_.wait(lock, [this] { return (!queue_.empty() && pauses_ == 0) || stop_requested_; });
     if (queue_.empty()) break;  // stop requested and nothing left
+    if (pauses_ > 0) {  // a stop request while loop closing holds a pause: finish after it
+      cv_.wait(lock, [this] { return pauses_ == 0; });
+      continue;
+    }
     process_front(lock);
   }
 }
@@ -122,10 +142,13 @@ void LocalMapper::process(map::KeyFrame* kf, bool more_waiting) {
     if (options_.local_ba && map_.num_keyframes() > 2) local_bundle_adjustment(kf);
     cull_keyframes(kf);
   }
-  std::lock_guard lock(stats_mutex_);
-  stats_.keyframe_ms.push_back(ms_since(t0));
-  stats_.triangulation_ms.push_back(triangulation_ms);
-  if (fusion_ms >= 0) stats_.fusion_ms.push_back(fusion_ms);
+  {
+    std::lock_guard lock(stats_mutex_);
+    stats_.keyframe_ms.push_back(ms_since(t0));
+    stats_.triangulation_ms.push_back(triangulation_ms);
+    if (fusion_ms >= 0) stats_.fusion_ms.push_back(fusion_ms);
+  }
+  if (sink_ && !kf->is_bad()) sink_(kf);
 }
 
 void LocalMapper::process_new_keyframe(map::KeyFrame* kf) {
@@ -333,34 +356,11 @@ void LocalMapper::fuse(map::KeyFrame* kf) {
   int fused = 0;
   const auto points = kf->map_points();
   for (map::KeyFrame* kf2 : kf->best_covisibles(10)) {
-    const auto& d2 = kf2->data();
-    const geometry::StereoCamera cam(d2.calib);
     const geometry::SE3 T2 = kf2->pose();
     const Eigen::Vector3d O2 = kf2->camera_center();
     for (map::MapPoint* mp : points) {
       if (!mp || mp->is_bad() || mp->index_in(kf2) >= 0) continue;
-      const Eigen::Vector3d P = mp->position();
-      const Eigen::Vector3d Xc = T2 * P;
-      if (Xc.z() <= 0) continue;
-      const Eigen::Vector2d uv = cam.project(Xc);
-      if (!cam.in_image(uv)) continue;
-      const double dist = (P - O2).norm();
-      if (dist < mp->min_distance() || dist > mp->max_distance()) continue;
-      const int level = mp->predict_level(dist, d2.levels, d2.scale_factor);
-      const double r = 3.0 * d2.level_scale(level);
-      const cv::Mat desc = mp->descriptor();
-      if (desc.empty()) continue;
-      int best = 50, best_j = -1;
-      for (int j : d2.points_in_area(uv.x(), uv.y(), r, std::max(0, level - 1), level + 1)) {
-        const auto& kp = d2.keypoints[static_cast<std::size_t>(j)];
-        const double e2 = (uv - Eigen::Vector2d(kp.pt.x, kp.pt.y)).squaredNorm();
-        if (e2 > 7.8 * d2.level_sigma2(kp.octave)) continue;
-        const int h = map::descriptor_distance(desc, d2.descriptors.row(j));
-        if (h < best) {
-          best = h;
-          best_j = j;
-        }
-      }
+      const int best_j = match_point_in_keyframe(*kf2, T2, O2, *mp);
       if (best_j < 0) continue;
       map::MapPoint* other = kf2->map_point(best_j);
       if (other && !other->is_bad()) {
@@ -396,71 +396,10 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf) {
   for (auto* n : kf->covisibles()) {
     if (!n->is_bad()) local.push_back(n);
   }
-  std::unordered_map<map::KeyFrame*, int> kf_index;
-  optim::BaProblem problem;
-  auto add_kf = [&](map::KeyFrame* k, bool fixed) {
-    kf_index[k] = static_cast<int>(problem.keyframes.size());
-    problem.keyframes.push_back({k->pose(), fixed || k->id() == 0});
-  };
-  for (auto* k : local) add_kf(k, false);
-
-  std::vector<map::MapPoint*> points;
-  std::vector<map::MapLine*> lines;
-  std::unordered_set<map::MapPoint*> seen_p;
-  std::unordered_set<map::MapLine*> seen_l;
-  for (auto* k : local) {
-    for (auto* mp : k->map_points()) {
-      if (mp && !mp->is_bad() && seen_p.insert(mp).second) points.push_back(mp);
-    }
-    if (options_.lines) {
-      for (auto* ml : k->map_lines()) {
-        if (ml && !ml->is_bad() && seen_l.insert(ml).second) lines.push_back(ml);
-      }
-    }
-  }
-  struct PointObsRef {
-    map::MapPoint* mp;
-    map::KeyFrame* kf;
-  };
-  struct LineObsRef {
-    map::MapLine* ml;
-    map::KeyFrame* kf;
-  };
-  std::vector<PointObsRef> point_refs;
-  std::vector<LineObsRef> line_refs;
-  for (std::size_t p = 0; p < points.size(); ++p) {
-    problem.points.push_back({points[p]->position(), false});
-    for (const auto& [k, idx] : points[p]->observations()) {
-      if (k->is_bad()) continue;
-      if (!kf_index.count(k)) add_kf(k, true);
-      const auto& d = k->data();
-      const auto& kp = d.keypoints[static_cast<std::size_t>(idx)];
-      optim::StereoPointObservation o;
-      o.keyframe = kf_index[k];
-      o.point = static_cast<int>(p);
-      o.measurement = {kp.pt.x, kp.pt.y, d.u_right[static_cast<std::size_t>(idx)]};
-      o.has_right = d.stereo_constraint(static_cast<std::size_t>(idx), options_.far_stereo_baselines);
-      o.level = kp.octave;
-      problem.point_observations.push_back(o);
-      point_refs.push_back({points[p], k});
-    }
-  }
-  for (std::size_t l = 0; l < lines.size(); ++l) {
-    problem.lines.push_back({lines[l]->start(), lines[l]->end(), false});
-    for (const auto& [k, idx] : lines[l]->observations()) {
-      if (k->is_bad()) continue;
-      if (!kf_index.count(k)) add_kf(k, true);
-      const auto& obs = k->data().lines[static_cast<std::size_t>(idx)];
-      optim::StereoLineObservation o;
-      o.keyframe = kf_index[k];
-      o.line = static_cast<int>(l);
-      o.left_line = obs.left_line;
-      o.right_line = obs.right_line;
-      o.information = options_.line_information;
-      problem.line_observations.push_back(o);
-      line_refs.push_back({lines[l], k});
-    }
-  }
+  MapBaProblem window(options_.line_information, options_.far_stereo_baselines, options_.lines);
+  for (auto* k : local) window.add_keyframe(k, k->id() == 0);
+  window.add_landmarks_of(local);
+  const auto& problem = window.problem;
   if (problem.point_observations.empty()) return;
 
   optim::BaOptions ba;
@@ -475,20 +414,26 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf) {
     return;
   }
   std::lock_guard lock(map_.update_mutex());
-  for (std::size_t i = 0; i < point_refs.size(); ++i) {
+  const auto& points = window.points;
+  const auto& lines = window.lines;
+  for (std::size_t i = 0; i < window.point_observers.size(); ++i) {
     if (!result.point_observation_outlier[i]) continue;
-    const int idx = point_refs[i].mp->index_in(point_refs[i].kf);
-    if (idx >= 0) point_refs[i].kf->erase_map_point(idx);
-    point_refs[i].mp->erase_observation(point_refs[i].kf);
+    map::MapPoint* mp = points[static_cast<std::size_t>(problem.point_observations[i].point)];
+    map::KeyFrame* k = window.point_observers[i];
+    const int idx = mp->index_in(k);
+    if (idx >= 0) k->erase_map_point(idx);
+    mp->erase_observation(k);
   }
-  for (std::size_t i = 0; i < line_refs.size(); ++i) {
+  for (std::size_t i = 0; i < window.line_observers.size(); ++i) {
     if (!result.line_observation_outlier[i]) continue;
-    const int idx = line_refs[i].ml->index_in(line_refs[i].kf);
-    if (idx >= 0) line_refs[i].kf->erase_map_line(idx);
-    line_refs[i].ml->erase_observation(line_refs[i].kf);
+    map::MapLine* ml = lines[static_cast<std::size_t>(problem.line_observations[i].line)];
+    map::KeyFrame* k = window.line_observers[i];
+    const int idx = ml->index_in(k);
+    if (idx >= 0) k->erase_map_line(idx);
+    ml->erase_observation(k);
   }
-  for (const auto& [k, i] : kf_index) {
-    if (!problem.keyframes[static_cast<std::size_t>(i)].fixed) k->set_pose(result.poses[static_cast<std::size_t>(i)]);
+  for (std::size_t i = 0; i < window.keyframes.size(); ++i) {
+    if (!problem.keyframes[i].fixed) window.keyframes[i]->set_pose(result.poses[i]);
   }
   for (std::size_t p = 0; p < points.size(); ++p) {
     if (points[p]->is_bad()) continue;
@@ -498,6 +443,7 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf) {
   for (std::size_t l = 0; l < lines.size(); ++l) {
     if (lines[l]->is_bad()) continue;
     lines[l]->set_endpoints(result.lines[l].start, result.lines[l].end);
+    lines[l]->refit_to_observations();
     lines[l]->update_normal_and_depth();
   }
   std::lock_guard stats_lock(stats_mutex_);
@@ -509,7 +455,7 @@ void LocalMapper::cull_keyframes(map::KeyFrame* kf) {
   // scale, by at least three other keyframes (ORB-SLAM2's KeyFrameCulling).
   int culled = 0;
   for (map::KeyFrame* k : kf->covisibles()) {
-    if (k->id() == 0 || k->is_bad()) continue;
+    if (k->id() == 0 || k->is_bad() || !k->loop_edges().empty()) continue;
     const auto& d = k->data();
     const double th_depth = 40.0 * d.calib.baseline;
     const auto pts = k->map_points();

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <list>
 #include <mutex>
 #include <thread>
@@ -57,6 +58,13 @@ class LocalMapper {
   // Place recognition: each processed keyframe is described and added, each culled one forgotten.
   // Not owned; set before start().
   void set_keyframe_database(place::KeyframeDatabase* database) { database_ = database; }
+  // Receives each keyframe once it is processed (loop closing's queue). Set before start().
+  void set_keyframe_sink(std::function<void(map::KeyFrame*)> sink) { sink_ = std::move(sink); }
+  // Loop closing: pause() returns once the keyframe in progress is done, and no other starts until
+  // every pause() has had its resume() (loop correction and the global BA merge may overlap).
+  // Keyframes keep queueing meanwhile. No effect on process_pending().
+  void pause();
+  void resume();
   bool idle() const;
   std::size_t queued() const;
   // Processes every queued keyframe in the calling thread (deterministic mode and tests).
@@ -81,12 +89,14 @@ class LocalMapper {
   map::Map& map_;
   LocalMapperOptions options_;
   place::KeyframeDatabase* database_ = nullptr;
+  std::function<void(map::KeyFrame*)> sink_;
 
   mutable std::mutex queue_mutex_;
   std::condition_variable cv_;
   std::deque<map::KeyFrame*> queue_;
   bool busy_ = false;
   bool stop_requested_ = false;
+  int pauses_ = 0;
   std::thread thread_;
 
   // Touched only by the mapping thread (or the caller of process_pending()).

@@ -2,8 +2,13 @@
 // group 0 so DENSE_SCHUR / SPARSE_SCHUR eliminate them first.
 #include <cmath>
 #include <memory>
+#include <vector>
 
+#include <Eigen/Core>
+
+#include <ceres/iteration_callback.h>
 #include <ceres/loss_function.h>
+#include <ceres/manifold.h>
 #include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
@@ -12,6 +17,67 @@
 #include "plslam/optim/ceres_costs.h"
 
 namespace plslam::optim {
+namespace {
+
+// Stops the solver after the current iteration once the caller raises the flag.
+class AbortCallback : public ceres::IterationCallback {
+ public:
+  explicit AbortCallback(const std::atomic<bool>* flag) : flag_(flag) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return flag_ && flag_->load() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::atomic<bool>* flag_;
+};
+
+// A line's two endpoints move only across the line (2 + 2 tangent directions): along it they are
+// unobservable and would slide, even collapse (see the stiffness in ba_schur_lm.cpp, which holds
+// them the same way).
+class LineEndpointsManifold : public ceres::Manifold {
+ public:
+  explicit LineEndpointsManifold(const Eigen::Vector3d& direction) {
+    const Eigen::Vector3d d = direction.normalized();
+    const Eigen::Vector3d helper = std::abs(d.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    B_.col(0) = d.cross(helper).normalized();
+    B_.col(1) = d.cross(B_.col(0));
+  }
+  int AmbientSize() const override { return 6; }
+  int TangentSize() const override { return 4; }
+  bool Plus(const double* x, const double* delta, double* out) const override {
+    Eigen::Map<Eigen::Matrix<double, 6, 1>> y(out);
+    y = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(x);
+    y.head<3>() += B_ * Eigen::Map<const Eigen::Vector2d>(delta);
+    y.tail<3>() += B_ * Eigen::Map<const Eigen::Vector2d>(delta + 2);
+    return true;
+  }
+  bool PlusJacobian(const double*, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, 6, 4, Eigen::RowMajor>> J(jacobian);
+    J.setZero();
+    J.block<3, 2>(0, 0) = B_;
+    J.block<3, 2>(3, 2) = B_;
+    return true;
+  }
+  bool Minus(const double* y, const double* x, double* out) const override {
+    const Eigen::Map<const Eigen::Matrix<double, 6, 1>> a(y), b(x);
+    Eigen::Map<Eigen::Vector4d> d(out);
+    d.head<2>() = B_.transpose() * (a.head<3>() - b.head<3>());
+    d.tail<2>() = B_.transpose() * (a.tail<3>() - b.tail<3>());
+    return true;
+  }
+  bool MinusJacobian(const double*, double* jacobian) const override {
+    Eigen::Map<Eigen::Matrix<double, 4, 6, Eigen::RowMajor>> J(jacobian);
+    J.setZero();
+    J.block<2, 3>(0, 0) = B_.transpose();
+    J.block<2, 3>(2, 3) = B_.transpose();
+    return true;
+  }
+
+ private:
+  Eigen::Matrix<double, 3, 2> B_;
+};
+
+}  // namespace
 
 BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& p,
                             const BaOptions& opt, const BaPassSpec& spec, BaState* s) {
@@ -43,11 +109,18 @@ BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& 
     }
     return x;
   };
+  std::vector<std::unique_ptr<LineEndpointsManifold>> line_manifolds;
   auto add_landmark = [&](double* x, int size, bool fixed, std::vector<bool>& added,
                           std::size_t k) {
     if (!added[k]) {
       added[k] = true;
-      problem.AddParameterBlock(x, size);
+      const Eigen::Vector3d d = size == 6 ? Eigen::Vector3d(x[3] - x[0], x[4] - x[1], x[5] - x[2]) : Eigen::Vector3d::Zero();
+      if (size == 6 && d.norm() > 1e-9) {
+        line_manifolds.push_back(std::make_unique<LineEndpointsManifold>(d));
+        problem.AddParameterBlock(x, size, line_manifolds.back().get());
+      } else {
+        problem.AddParameterBlock(x, size);
+      }
       if (fixed) problem.SetParameterBlockConstant(x);
       ordering->AddElementToGroup(x, 0);
     }
@@ -96,6 +169,8 @@ BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& 
     out.message = "no observations";  // not usable: nothing was optimised
     return out;
   }
+  AbortCallback abort_callback(opt.abort);
+  if (opt.abort) so.callbacks.push_back(&abort_callback);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
   for (std::size_t k = 0; k < poses.size(); ++k) {

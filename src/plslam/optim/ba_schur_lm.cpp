@@ -456,6 +456,7 @@ class SchurLm {
   std::vector<int> kf_of_cam_;
   Groups<PointKind> points_;
   Groups<LineKind> lines_;
+  std::vector<Eigen::Matrix3d> line_along_;  // per line slot: d d' of its direction (zero: collapsed)
   // Current linearisation (camera part) and step.
   Eigen::MatrixXd C_, C_next_;  // block diagonal, 6x6 per free camera
   Eigen::VectorXd gc_, gc_next_, dc_;
@@ -480,6 +481,14 @@ void SchurLm::build(const BaExclusions* excluded) {
   }
   points_ = make_groups<PointKind>(p_, opt_, PointKind::excluded(excluded), cam_of_kf_);
   lines_ = make_groups<LineKind>(p_, opt_, LineKind::excluded(excluded), cam_of_kf_);
+  // Each line's direction at the start of the pass: its endpoints move only across it.
+  line_along_.clear();
+  for (const int l : lines_.landmark) {
+    const Vector6d& L = s_->lines[static_cast<std::size_t>(l)];
+    const Eigen::Vector3d d = L.tail<3>() - L.head<3>();
+    line_along_.push_back(d.norm() > 1e-9 ? Eigen::Matrix3d(d.normalized() * d.normalized().transpose())
+                                          : Eigen::Matrix3d::Zero());
+  }
 }
 
 template <class Body>
@@ -614,6 +623,18 @@ void SchurLm::eliminate_slot(Groups<Kind>& G, int i, double lambda, Accumulator&
   const auto si = static_cast<std::size_t>(i);
   Eigen::Matrix<double, N, N> Hd = G.H[si];
   for (int j = 0; j < N; ++j) Hd(j, j) += lambda * damping_diagonal(G.H[si](j, j));
+  if constexpr (N == 6) {
+    // A line's endpoints are free along the 3D line, and the diagonal damping alone (lambda down
+    // to 1e-12) let them run there on the noise in the gradient: both converged to the one point
+    // that fits the observed planes best, and the segment collapsed. A stiffness along the line's
+    // direction, 1e9 times the block's constrained ones, holds them: the step moves each
+    // endpoint only across the line's direction at the start of the pass, as the Ceres backend's
+    // LineEndpointsManifold does.
+    const Eigen::Matrix3d& dd = line_along_[si];
+    constexpr double kAlongLine = 1e9;
+    Hd.template topLeftCorner<3, 3>() += kAlongLine * std::max(G.H[si].template topLeftCorner<3, 3>().trace(), kMinDiagonal) * dd;
+    Hd.template bottomRightCorner<3, 3>() += kAlongLine * std::max(G.H[si].template bottomRightCorner<3, 3>().trace(), kMinDiagonal) * dd;
+  }
   if (!invert_spd(Hd, &G.Hinv[si])) {
     ++acc.failures;
     return;
@@ -774,6 +795,10 @@ BaPassSummary SchurLm::run() {
   int accepted = 0;
   const char* why = "iteration limit";
   while (out.iterations < spec_.iterations) {
+    if (opt_.abort && opt_.abort->load()) {
+      why = "aborted";
+      break;
+    }
     if (gc_.size() == 0 && points_.slots() == 0 && lines_.slots() == 0) {
       why = "nothing free";
       break;

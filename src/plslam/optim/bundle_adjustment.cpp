@@ -99,7 +99,8 @@ BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& p,
   res.iterations = first.iterations;
   res.usable = first.usable;
   res.message = first.message;
-  if (opt.remove_outliers && opt.second_pass_iterations > 0) {
+  const auto aborted = [&] { return opt.abort && opt.abort->load(); };
+  if (opt.remove_outliers && opt.second_pass_iterations > 0 && !aborted()) {
     const BaExclusions g = gate(cam, p, opt, s);
     const auto second = run_pass(cam, p, opt, {false, opt.second_pass_iterations, &g}, &s);
     res.final_cost = second.final_cost;
@@ -107,6 +108,7 @@ BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& p,
     res.usable = res.usable && second.usable;
     res.message = second.message;
   }
+  res.aborted = aborted();
   BaExclusions final_gates = gate(cam, p, opt, s);
   res.point_observation_outlier = std::move(final_gates.point_out);
   res.line_observation_outlier = std::move(final_gates.line_out);

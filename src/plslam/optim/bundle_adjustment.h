@@ -6,6 +6,7 @@
 // (ba_ceres_pass.cpp, DENSE_SCHUR / SPARSE_SCHUR). The problem is plain data: keyframe
 // poses T_cw with fixed flags, landmarks, and observations indexing them. A local BA is this
 // problem restricted to a window, with the covisible keyframes outside it marked fixed.
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,9 @@ struct BaOptions {
   int max_dense_keyframes = 300;
   BaLinearSolver linear_solver = BaLinearSolver::kDenseSchur;
   int num_threads = 1;  // both backends (kSchurLM: core::WorkerPool over landmarks, fixed ranges)
+  // Set from another thread to stop after the current iteration (a global BA that a new loop
+  // makes obsolete); the result then says `aborted`. Not owned; may be null.
+  const std::atomic<bool>* abort = nullptr;
 };
 
 struct BaResult {
@@ -84,6 +88,7 @@ struct BaResult {
   double final_cost = 0.0;    // ... at the end of the last pass
   int iterations = 0;
   bool usable = false;  // the solver produced a usable solution (false: no observations)
+  bool aborted = false;  // options.abort was raised: the state is partial
   std::string message;  // the solver's brief report of the last pass (for logs)
 };
 

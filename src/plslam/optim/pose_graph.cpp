@@ -50,6 +50,10 @@ PoseGraphResult optimize_pose_graph(const std::vector<geometry::SE3>& poses,
   if (problem.NumResidualBlocks() > 0) {
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    // Eigen's sparse Cholesky, not CHOLMOD: CHOLMOD is built with OpenMP here, whose uninstrumented
+    // worker threads ThreadSanitizer reports as racing with the loop-closing thread; a graph of a
+    // few hundred keyframes is a small system either way.
+    so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
     so.max_num_iterations = options.iterations;
     so.num_threads = options.num_threads;
     so.logging_type = ceres::SILENT;

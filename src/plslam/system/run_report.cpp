@@ -10,6 +10,39 @@
 #include "plslam/eval/evaluate.h"
 
 namespace plslam::system {
+namespace {
+
+nlohmann::json loops_json(const System& slam) {
+  nlohmann::json out = nlohmann::json::array();
+  if (!slam.loop_closer()) return out;
+  for (const auto& l : slam.loop_closer()->stats().loops) {
+    out.push_back({{"frame", l.frame}, {"keyframe", l.keyframe}, {"matched_keyframe", l.matched_keyframe},
+                   {"matched_frame", l.matched_frame}, {"inliers", l.inliers}, {"fused_points", l.fused_points},
+                   {"fused_lines", l.fused_lines}, {"correction_ms", l.correction_ms}});
+  }
+  return out;
+}
+
+std::vector<double> loop_correction_ms(const System& slam) {
+  std::vector<double> out;
+  if (slam.loop_closer()) {
+    for (const auto& l : slam.loop_closer()->stats().loops) out.push_back(l.correction_ms);
+  }
+  return out;
+}
+
+nlohmann::json loop_closing_json(const System& slam) {
+  if (!slam.loop_closer()) return {{"enabled", false}};
+  const auto s = slam.loop_closer()->stats();
+  return {{"enabled", true}, {"detections", s.detections}, {"rejected", s.rejected}, {"implausible", s.implausible}};
+}
+
+nlohmann::json global_ba_ms(const System& slam) {
+  return slam.loop_closer() ? nlohmann::json(slam.loop_closer()->stats().global_ba_ms) : nlohmann::json::array();
+}
+
+}  // namespace
+
 const char* RunReport::frames_csv_header() {
   return "frame,timestamp,state,tracked,keyframe,keyframe_reason,point_inliers,line_inliers,reference_tracked,"
          "keyframe_threshold,delta_pid,speed_mps,tracked_close,untracked_close,local_keyframes,local_points,"
@@ -78,6 +111,12 @@ nlohmann::json RunReport::to_json(const System& slam) const {
                                 {"vocabulary_words", slam.keyframe_database()->vocabulary().size()},
                                 {"database_keyframes", slam.keyframe_database()->size()}}
                : nlohmann::json{{"enabled", false}}},
+          {"loop_closing", loop_closing_json(slam)},
+          {"loops", loops_json(slam)},
+          {"loop_correction_ms", loop_correction_ms(slam)},
+          {"global_ba_ms", global_ba_ms(slam)},
+          {"global_ba_runs", slam.loop_closer() ? slam.loop_closer()->stats().global_ba_runs : 0},
+          {"global_ba_aborted", slam.loop_closer() ? slam.loop_closer()->stats().global_ba_aborted : 0},
           {"skipped_frames", skipped.size()},
           {"skipped", skipped_json},
           {"untracked_kitti_lines", untracked_lines},
@@ -103,11 +142,12 @@ nlohmann::json RunReport::to_json(const System& slam) const {
 
 std::string RunReport::summary(const System& slam) const {
   return fmt::format(
-      "frames {} (tracked {}, skipped {}), lost events {}, relocalizations {}, new map segments {}, keyframes {}, "
-      "map points {}, map lines {}\n"
+      "frames {} (tracked {}, skipped {}), lost events {}, relocalizations {}, new map segments {}, loops {}, "
+      "keyframes {}, map points {}, map lines {}\n"
       "tracking ms/frame: median {:.1f}, mean {:.1f}, p90 {:.1f}\n",
       frames, tracked_frames, skipped.size(), slam.tracker().lost_events(), slam.tracker().relocalized_frames().size(),
-      slam.tracker().new_segment_frames().size(), slam.map().num_keyframes(), slam.map().num_points(),
+      slam.tracker().new_segment_frames().size(), slam.loop_closer() ? slam.loop_closer()->stats().loops.size() : 0,
+      slam.map().num_keyframes(), slam.map().num_points(),
       slam.map().num_lines(), percentile(tracking_ms, 0.5), mean(tracking_ms), percentile(tracking_ms, 0.9));
 }
 

@@ -45,13 +45,25 @@ System::System(const StereoCalibration& calib, SystemOptions options, std::share
   if (vocabulary) database_ = std::make_unique<place::KeyframeDatabase>(std::move(vocabulary));
   mapper_ = std::make_unique<mapping::LocalMapper>(map_, options_.mapper);
   mapper_->set_keyframe_database(database_.get());
+  if (database_ && options_.loop_closing) {
+    options_.loop.verifier.seed = options_.seed;
+    options_.loop.correction.lines = options_.mapper.lines;
+    options_.loop.global_ba_options.lines = options_.mapper.lines;
+    options_.loop.global_ba_options.line_information = options_.mapper.line_information;
+    options_.loop.global_ba_options.far_stereo_baselines = options_.mapper.far_stereo_baselines;
+    loop_closer_ = std::make_unique<loop::LoopCloser>(map_, *database_, *mapper_, options_.loop);
+    mapper_->set_keyframe_sink([closer = loop_closer_.get()](map::KeyFrame* kf) { closer->insert(kf); });
+  }
   auto* mapper = mapper_.get();
   const bool sequential = options_.sequential;
   tracker_ = std::make_unique<tracking::Tracker>(
       map_, options_.tracker, [mapper](map::KeyFrame* kf) { mapper->insert(kf); },
       [mapper, sequential] { return sequential || mapper->idle(); });
   tracker_->set_keyframe_database(database_.get());
-  if (!sequential) mapper_->start();
+  if (!sequential) {
+    mapper_->start();
+    if (loop_closer_) loop_closer_->start();
+  }
 }
 
 System::~System() { finish(); }
@@ -66,7 +78,10 @@ FrameResult System::process(const io::StereoFrame& frame) {
   auto data = extractor_.extract(static_cast<long>(frame.index), frame.timestamp, frame.left, frame.right, &r.extraction);
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
-  if (options_.sequential) mapper_->process_pending();
+  if (options_.sequential) {
+    mapper_->process_pending();
+    if (loop_closer_) loop_closer_->process_pending();
+  }
   return r;
 }
 
@@ -75,6 +90,10 @@ void System::finish() {
   finished_ = true;
   mapper_->wait_idle();
   mapper_->stop();
+  if (loop_closer_) {
+    loop_closer_->finish();
+    loop_closer_->stop();
+  }
 }
 
 Trajectory System::tracked_trajectory() const {

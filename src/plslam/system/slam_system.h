@@ -10,6 +10,7 @@
 #include "plslam/core/types.h"
 #include "plslam/io/dataset.h"
 #include "plslam/map/map.h"
+#include "plslam/loop/loop_closer.h"
 #include "plslam/mapping/local_mapper.h"
 #include "plslam/place/keyframe_database.h"
 #include "plslam/tracking/frame_extractor.h"
@@ -29,6 +30,9 @@ struct SystemOptions {
   // relocalization queries; empty: the default vocabulary shipped in data/.
   bool place_recognition = true;
   std::filesystem::path vocabulary;
+  // Loop closing (config `loop`, --no-loop-closing): needs place recognition.
+  bool loop_closing = true;
+  loop::LoopClosingOptions loop;
 
   static SystemOptions euroc();
   static SystemOptions kitti();
@@ -69,6 +73,8 @@ class System {
   // Null without place recognition.
   const place::KeyframeDatabase* keyframe_database() const { return database_.get(); }
   mapping::LocalMapperStats mapper_stats() const { return mapper_->stats(); }
+  // Null without loop closing.
+  const loop::LoopCloser* loop_closer() const { return loop_closer_.get(); }
 
  private:
   SystemOptions options_;
@@ -76,6 +82,7 @@ class System {
   tracking::FrameExtractor extractor_;
   std::unique_ptr<place::KeyframeDatabase> database_;
   std::unique_ptr<mapping::LocalMapper> mapper_;
+  std::unique_ptr<loop::LoopCloser> loop_closer_;
   std::unique_ptr<tracking::Tracker> tracker_;
   bool finished_ = false;
 };

@@ -97,6 +97,29 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
   reloc.get("new_segment_after_s", r.new_segment_after_s);
   if (!(r.new_segment_after_s >= 0)) throw InputError(config.source(), "relocalization.new_segment_after_s: must be >= 0");
 
+  const auto loop = config.section("loop");
+  loop.get("enabled", o.loop_closing);
+  auto& l = o.loop;
+  loop.get("consistency", l.detector.consistency);
+  loop.get("min_matches", l.verifier.min_matches);
+  loop.get("min_inliers", l.verifier.min_inliers);
+  loop.get("min_projection_inliers", l.min_projection_inliers);
+  loop.get("projection_radius", l.projection_radius);
+  loop.get("keyframes_between_loops", l.keyframes_between_loops);
+  loop.get("max_drift_ratio", l.max_drift_ratio);
+  loop.get("min_drift_m", l.min_drift_m);
+  loop.get("max_drift_deg", l.max_drift_deg);
+  loop.get("essential_min_weight", l.correction.graph.min_covisibility_weight);
+  loop.get("essential_iterations", l.correction.graph.iterations);
+  loop.get("global_ba", l.global_ba);
+  loop.get("global_ba_iterations", l.global_ba_options.iterations);
+  loop.get("finish_wait_s", l.finish_wait_s);
+  try {
+    l.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(config.source(), e.what());
+  }
+
   const auto system = config.section("system");
   int seed = static_cast<int>(o.seed);
   system.get("seed", seed);

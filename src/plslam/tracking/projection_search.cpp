@@ -9,6 +9,7 @@
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/map/descriptor_utils.h"
 #include "plslam/map/keyframe.h"
+#include "plslam/map/line_projection.h"
 #include "plslam/map/map_line.h"
 #include "plslam/map/map_point.h"
 
@@ -129,45 +130,19 @@ int search_lines(Frame& cur, const std::vector<map::MapLine*>& candidates, doubl
   if (d.lines.empty()) return 0;
   const geometry::StereoCamera cam(d.calib);
   std::unordered_set<const map::MapLine*> already(cur.lines.begin(), cur.lines.end());
-  const double cos_max_angle = std::cos(o.line_max_angle_deg * M_PI / 180.0);
+  const map::LineMatchGate gate{radius, o.line_max_angle_deg, o.line_min_overlap};
+  // Frame lines already matched to a map line with observations are taken.
+  const auto taken = [&cur](std::size_t j) { return cur.lines[j] && cur.lines[j]->num_observations() > 0; };
   int matches = 0;
   for (map::MapLine* ml : candidates) {
     if (!ml || ml->is_bad() || already.count(ml)) continue;
-    const Eigen::Vector3d s = cur.T_cw * ml->start();
-    const Eigen::Vector3d e = cur.T_cw * ml->end();
-    if (s.z() <= 0.05 || e.z() <= 0.05) continue;
-    const Eigen::Vector2d ps = cam.project(s), pe = cam.project(e);
-    if (!cam.in_image(ps) && !cam.in_image(pe)) continue;
-    const Eigen::Vector2d dir = pe - ps;
-    const double len = dir.norm();
-    if (len < 10) continue;
-    const Eigen::Vector2d u = dir / len;
+    const auto projected = map::project_line(cam, cur.T_cw, *ml);
+    if (!projected) continue;
     const cv::Mat desc = ml->descriptor();
     if (desc.empty()) continue;
     ml->increase_visible();
-    int best = std::numeric_limits<int>::max(), best_j = -1;
-    for (std::size_t j = 0; j < d.lines.size(); ++j) {
-      if (cur.lines[j] && cur.lines[j]->num_observations() > 0) continue;
-      const auto& seg = d.lines[j].segment;
-      const Eigen::Vector2d a(seg.start.x, seg.start.y), b(seg.end.x, seg.end.y);
-      const Eigen::Vector2d v = b - a;
-      const double vlen = v.norm();
-      if (vlen < 1e-6 || std::abs(u.dot(v / vlen)) < cos_max_angle) continue;
-      const Eigen::Vector3d& l = d.lines[j].left_line;
-      if (std::abs(l.x() * ps.x() + l.y() * ps.y() + l.z()) > radius ||
-          std::abs(l.x() * pe.x() + l.y() * pe.y() + l.z()) > radius) {
-        continue;
-      }
-      // Overlap of the candidate with the projected segment, along the projected direction.
-      const double ta = u.dot(a - ps), tb = u.dot(b - ps);
-      const double overlap = std::min(std::max(ta, tb), len) - std::max(std::min(ta, tb), 0.0);
-      if (overlap < o.line_min_overlap * len) continue;
-      const int dist = map::descriptor_distance(desc, d.line_descriptors.row(static_cast<int>(j)));
-      if (dist < best) {
-        best = dist;
-        best_j = static_cast<int>(j);
-      }
-    }
+    int best = 0;
+    const int best_j = map::best_line_match(d, *projected, desc, gate, taken, &best);
     if (best_j >= 0 && best <= o.line_max_hamming) {
       cur.lines[static_cast<std::size_t>(best_j)] = ml;
       cur.line_outlier[static_cast<std::size_t>(best_j)] = false;

@@ -64,6 +64,11 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   // Tracking reads poses and structure that local BA writes: hold the map-update lock for the
   // whole step so it never sees half an update.
   std::unique_lock map_lock(map_.update_mutex());
+  // A loop correction moved the keyframes: the last frame keeps its pose relative to its reference.
+  if (const long changes = map_.big_changes(); changes != seen_big_changes_) {
+    seen_big_changes_ = changes;
+    if (last_ && !records_.empty() && records_.back().reference) last_->T_cw = pose_of(records_.back());
+  }
 
   bool ok = false;
   auto clear_matches = [&f] {

@@ -167,6 +167,7 @@ class Tracker {
   std::vector<map::MapPoint*> local_points_;
   std::vector<map::MapLine*> local_lines_;
   std::vector<FrameRecord> records_;
+  long seen_big_changes_ = 0;  // map_.big_changes() when the last frame was tracked
   int lost_events_ = 0;
   const place::KeyframeDatabase* database_ = nullptr;
   std::optional<double> lost_since_;  // first textured frame that failed to relocalize

@@ -1,0 +1,16 @@
+#include "plslam/core/thread_priority.h"
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+namespace plslam::core {
+
+bool lower_this_thread_priority(int nice_increment) {
+  // On Linux a thread is a task with its own nice value: PRIO_PROCESS with the thread id.
+  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+  const int current = getpriority(PRIO_PROCESS, tid);
+  return setpriority(PRIO_PROCESS, tid, current + nice_increment) == 0;
+}
+
+}  // namespace plslam::core

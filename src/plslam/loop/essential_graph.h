@@ -1,0 +1,43 @@
+#pragma once
+// The essential graph of a map (ORB-SLAM2's OptimizeEssentialGraph, in SE(3) since stereo fixes
+// the scale): every keyframe, linked by its spanning-tree edge, by the loop edges of earlier loops,
+// by strong covisibility edges, and by the new connections the loop being closed just made. The
+// old edges keep the relative poses odometry measured (the poses before the correction); the new
+// loop connections take the corrected poses. The pose graph spreads the loop error over the map.
+#include <vector>
+
+#include "plslam/geometry/se3.h"
+#include "plslam/map/by_id.h"
+#include "plslam/map/keyframe.h"
+
+namespace plslam::loop {
+
+struct EssentialGraphOptions {
+  int min_covisibility_weight = 100;  // config loop.essential_min_weight (ORB-SLAM2: 100)
+  int iterations = 20;
+  // Throws std::invalid_argument naming the bad field.
+  void validate() const;
+};
+
+struct EssentialGraphInput {
+  std::vector<map::KeyFrame*> keyframes;            // the nodes (good keyframes)
+  map::IdMap<map::KeyFrame, geometry::SE3> odometry;  // T_cw before the correction, every node
+  map::IdMap<map::KeyFrame, geometry::SE3> initial;   // T_cw where the optimisation starts, every node
+  // Keyframe -> keyframes on the other side of the loop it is now connected to.
+  map::IdMap<map::KeyFrame, map::IdSet<map::KeyFrame>> loop_connections;
+  map::KeyFrame* query = nullptr;      // the keyframe that found the loop
+  map::KeyFrame* candidate = nullptr;  // the place it found: fixed, it anchors the map
+};
+
+struct EssentialGraphResult {
+  map::IdMap<map::KeyFrame, geometry::SE3> poses;  // optimised T_cw, every node
+  int edges = 0;
+  int loop_edges = 0;  // of them, new loop connections
+  double initial_cost = 0, final_cost = 0;
+  bool usable = false;
+};
+
+// Reads the graph (parents, loop edges, covisibility weights); writes nothing to the map.
+EssentialGraphResult optimize_essential_graph(const EssentialGraphInput& input, const EssentialGraphOptions& options = {});
+
+}  // namespace plslam::loop

@@ -1,0 +1,353 @@
+#include "plslam/loop/loop_closer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "plslam/core/stopwatch.h"
+#include "plslam/core/thread_priority.h"
+#include "plslam/geometry/stereo_camera.h"
+#include "plslam/optim/pose_only.h"
+
+namespace plslam::loop {
+namespace {
+
+// How much lower the loop-closing and global-BA threads run than tracking and local mapping.
+constexpr int kBackgroundNice = 5;
+
+// Local mapping stays paused while this lives.
+class MapperPause {
+ public:
+  explicit MapperPause(mapping::LocalMapper& m) : m_(m) { m_.pause(); }
+  ~MapperPause() { m_.resume(); }
+  MapperPause(const MapperPause&) = delete;
+  MapperPause& operator=(const MapperPause&) = delete;
+
+ private:
+  mapping::LocalMapper& m_;
+};
+
+}  // namespace
+
+void LoopClosingOptions::validate() const {
+  detector.validate();
+  verifier.validate();
+  correction.graph.validate();
+  if (min_projection_inliers < verifier.min_inliers) {
+    throw std::invalid_argument("loop.min_projection_inliers: must be >= loop.min_inliers");
+  }
+  if (!(max_drift_ratio >= 0)) throw std::invalid_argument("loop.max_drift_ratio: must be >= 0");
+  if (!(min_drift_m >= 0)) throw std::invalid_argument("loop.min_drift_m: must be >= 0");
+  if (!(max_drift_deg > 0)) throw std::invalid_argument("loop.max_drift_deg: must be positive");
+  if (!(projection_radius > 0)) throw std::invalid_argument("loop.projection_radius: must be positive");
+  if (keyframes_between_loops < 0) throw std::invalid_argument("loop.keyframes_between_loops: must be >= 0");
+  global_ba_options.validate();
+  if (!(finish_wait_s >= 0)) throw std::invalid_argument("loop.finish_wait_s: must be >= 0");
+}
+
+LoopCloser::LoopCloser(map::Map& map, const place::KeyframeDatabase& database, mapping::LocalMapper& mapper,
+                       LoopClosingOptions options)
+    : map_(map), database_(database), mapper_(mapper), options_(std::move(options)),
+      detector_(database, options_.detector) {
+  options_.validate();
+}
+
+LoopCloser::~LoopCloser() {
+  stop();
+  abort_global_ba();
+}
+
+void LoopCloser::start() {
+  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+}
+
+void LoopCloser::stop() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    stop_requested_ = true;
+  }
+  cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void LoopCloser::insert(map::KeyFrame* kf) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    queue_.push_back(kf);
+  }
+  cv_.notify_all();
+}
+
+void LoopCloser::process_pending() {
+  std::unique_lock lock(queue_mutex_);
+  while (!queue_.empty()) {
+    map::KeyFrame* kf = queue_.front();
+    queue_.pop_front();
+    lock.unlock();
+    process(kf);
+    lock.lock();
+  }
+}
+
+void LoopCloser::wait_idle() {
+  if (!thread_.joinable()) {
+    process_pending();
+    return;
+  }
+  std::unique_lock lock(queue_mutex_);
+  cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || stop_requested_; });
+}
+
+bool LoopCloser::finish() {
+  wait_idle();
+  std::unique_lock lock(gba_mutex_);
+  const bool done = gba_cv_.wait_for(lock, std::chrono::duration<double>(options_.finish_wait_s),
+                                     [this] { return !gba_running_; });
+  lock.unlock();
+  if (!done) {
+    spdlog::warn("global BA still running after {:.0f} s: aborted; the outputs use the map as the loop correction left it",
+                 options_.finish_wait_s);
+  }
+  abort_global_ba();
+  return done;
+}
+
+void LoopCloser::abort_global_ba() {
+  if (!gba_thread_.joinable()) return;
+  gba_abort_ = true;
+  gba_thread_.join();
+  gba_abort_ = false;
+}
+
+void LoopCloser::global_ba() {
+  const auto t0 = std::chrono::steady_clock::now();
+  GlobalBaSnapshot snapshot;
+  {
+    // Local mapping is the only writer of poses and positions besides loop closing.
+    MapperPause pause(mapper_);
+    snapshot = snapshot_for_global_ba(map_, options_.global_ba_options);
+  }
+  const auto result = run_global_ba(snapshot, options_.global_ba_options, &gba_abort_);
+  if (result.aborted || gba_abort_ || !result.usable) {
+    spdlog::info("global BA {}", result.usable ? "aborted" : "unusable: " + result.message);
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.global_ba_aborted;
+    return;
+  }
+  GlobalBaMergeStats merged;
+  {
+    MapperPause pause(mapper_);
+    std::lock_guard map_lock(map_.update_mutex());
+    merged = merge_global_ba(map_, snapshot, result);
+  }
+  const double ms = ms_since(t0);
+  spdlog::info("global BA: {} keyframes, {} points, {} lines, {} iterations, cost {:.4g} -> {:.4g}; merged with {} new "
+               "keyframes; {:.0f} ms",
+               merged.keyframes, merged.points, merged.lines, result.iterations, result.initial_cost, result.final_cost,
+               merged.propagated_keyframes, ms);
+  std::lock_guard lock(stats_mutex_);
+  stats_.global_ba_ms.push_back(ms);
+  ++stats_.global_ba_runs;
+}
+
+LoopClosingStats LoopCloser::stats() const {
+  std::lock_guard lock(stats_mutex_);
+  return stats_;
+}
+
+void LoopCloser::run() {
+  // Loop closing can wait; tracking cannot (a corrected loop is worth the same a frame later).
+  core::lower_this_thread_priority(kBackgroundNice);
+  std::unique_lock lock(queue_mutex_);
+  for (;;) {
+    cv_.wait(lock, [this] { return !queue_.empty() || stop_requested_; });
+    if (queue_.empty()) break;
+    map::KeyFrame* kf = queue_.front();
+    queue_.pop_front();
+    busy_ = true;
+    lock.unlock();
+    process(kf);
+    lock.lock();
+    busy_ = false;
+    cv_.notify_all();
+  }
+}
+
+std::optional<LoopConstraint> LoopCloser::confirm(map::KeyFrame* kf, const LoopDetection& d) {
+  auto c = verify_loop(kf, d.keyframe, database_, options_.verifier);
+  if (!c) return std::nullopt;
+  // The place's map points, projected into the keyframe with the verified pose, give more
+  // matches; the keyframe's pose refined over all their reprojection errors must keep enough.
+  const auto& qd = kf->data();
+  const geometry::SE3 T_cw = d.keyframe->pose();
+  geometry::SE3 T_qw = (c->T_query_candidate * T_cw).normalized();
+  std::vector<map::MapPoint*> matched(qd.keypoints.size(), nullptr);  // place point per query keypoint
+  map::IdSet<map::MapPoint> used;
+  for (const auto& [qp, cp] : c->matches) {
+    const int i = qp->index_in(kf);
+    if (i >= 0 && used.insert(cp).second) matched[static_cast<std::size_t>(i)] = cp;
+  }
+  mapping::ProjectionMatchOptions pm;
+  pm.point_radius = options_.projection_radius;
+  pm.point_chi2 = options_.projection_radius * options_.projection_radius;
+  const Eigen::Vector3d O = T_qw.inverse().translation();
+  map::IdSet<map::MapPoint> place_points;
+  for (map::KeyFrame* k : [&] {
+         auto v = d.keyframe->covisibles();
+         v.insert(v.begin(), d.keyframe);
+         return v;
+       }()) {
+    for (map::MapPoint* p : k->map_points()) {
+      if (p && !p->is_bad()) place_points.insert(p);
+    }
+  }
+  for (map::MapPoint* p : place_points) {
+    if (used.count(p)) continue;
+    const int j = mapping::match_point_in_keyframe(*kf, T_qw, O, *p, pm);
+    if (j < 0 || matched[static_cast<std::size_t>(j)]) continue;
+    matched[static_cast<std::size_t>(j)] = p;
+    used.insert(p);
+  }
+  std::vector<optim::PosePointTerm> terms;
+  std::vector<std::size_t> term_keypoint;
+  for (std::size_t i = 0; i < matched.size(); ++i) {
+    if (!matched[i]) continue;
+    const auto& kp = qd.keypoints[i];
+    optim::PosePointTerm t;
+    t.world = matched[i]->position();
+    t.obs.measurement = {kp.pt.x, kp.pt.y, qd.u_right[i]};
+    t.obs.has_right = qd.u_right[i] >= 0;
+    t.obs.level = kp.octave;
+    terms.push_back(t);
+    term_keypoint.push_back(i);
+  }
+  if (static_cast<int>(terms.size()) < options_.min_projection_inliers) return std::nullopt;
+  optim::PoseOnlyOptions po;
+  po.scale_factor = qd.scale_factor;
+  const auto refined = optim::optimize_pose(geometry::StereoCamera(qd.calib), T_qw, terms, {}, po);
+  if (refined.num_point_inliers < options_.min_projection_inliers) {
+    spdlog::debug("loop: keyframe {} -> {}: {} of {} projected matches after refinement, rejected", kf->id(),
+                  d.keyframe->id(), refined.num_point_inliers, terms.size());
+    return std::nullopt;
+  }
+  c->T_query_candidate = (refined.T_cw * T_cw.inverse()).normalized();
+  if (!plausible(kf, d.keyframe, refined.T_cw)) return std::nullopt;
+  // The matches to fuse: the refinement's inliers whose keypoint already has a map point.
+  const auto q_points = kf->map_points();
+  c->matches.clear();
+  for (std::size_t t = 0; t < terms.size(); ++t) {
+    if (refined.point_outlier[t]) continue;
+    map::MapPoint* qp = q_points[term_keypoint[t]];
+    if (qp && !qp->is_bad()) c->matches.emplace_back(qp, matched[term_keypoint[t]]);
+  }
+  c->inliers = refined.num_point_inliers;
+  return c;
+}
+
+bool LoopCloser::plausible(map::KeyFrame* query, map::KeyFrame* candidate, const geometry::SE3& T_qw_corrected) {
+  // The path the keyframes travelled from the place to the query, in keyframe order.
+  double path = 0;
+  const map::KeyFrame* previous = nullptr;
+  for (map::KeyFrame* k : map_.keyframes()) {
+    if (k->id() < candidate->id() || k->id() > query->id()) continue;
+    if (previous) path += (k->camera_center() - previous->camera_center()).norm();
+    previous = k;
+  }
+  const geometry::SE3 T_qw = query->pose();
+  const double moved = (T_qw_corrected.inverse().translation() - T_qw.inverse().translation()).norm();
+  const double turned = Eigen::AngleAxisd((T_qw_corrected * T_qw.inverse()).rotation()).angle() * 180 / M_PI;
+  const double bound = options_.max_drift_ratio * path + options_.min_drift_m;
+  if (moved <= bound && turned <= options_.max_drift_deg) return true;
+  spdlog::debug("loop candidate rejected: keyframe {} (frame {}) -> {} (frame {}) would move it {:.2f} m and turn it {:.1f} "
+               "deg after {:.1f} m of path (bounds {:.2f} m, {:.0f} deg)",
+               query->id(), query->frame_id(), candidate->id(), candidate->frame_id(), moved, turned, path, bound,
+               options_.max_drift_deg);
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.implausible;
+  return false;
+}
+
+void LoopCloser::process(map::KeyFrame* kf) {
+  if (kf->is_bad()) return;
+  // A loop corrected while this keyframe waited in the queue may have fused its points into the
+  // place's: its covisibility must say so before the detector and the guard below read it.
+  if (map_.big_changes() > 0) kf->update_connections();
+  const auto detections = detector_.detect(kf);
+  if (detections.empty()) return;
+  if (last_loop_keyframe_ >= 0 && kf->id() < last_loop_keyframe_ + options_.keyframes_between_loops) return;
+  // Local BA moves the keyframes and points the verification compares: pause it from here on.
+  MapperPause pause(mapper_);
+  if (kf->is_bad()) return;
+  std::optional<LoopConstraint> loop;
+  int rejected = 0;
+  // A place the keyframe's neighbourhood already shares keyframes with is already tied to it (an
+  // earlier loop's fusion, or tracking that relocalized there): correcting it again would only
+  // move the map by the noise of a second estimate.
+  map::IdSet<map::KeyFrame> neighbourhood;
+  for (map::KeyFrame* n : kf->covisibles()) neighbourhood.insert(n);
+  for (const auto& d : detections) {
+    if (d.keyframe->is_bad()) continue;
+    const auto group = d.keyframe->covisibles();
+    if (std::any_of(group.begin(), group.end(), [&](map::KeyFrame* g) { return neighbourhood.count(g) > 0; })) {
+      continue;
+    }
+    loop = confirm(kf, d);
+    if (loop) break;
+    ++rejected;
+  }
+  {
+    std::lock_guard lock(stats_mutex_);
+    stats_.detections += static_cast<int>(detections.size());
+    stats_.rejected += rejected;
+  }
+  if (!loop) return;
+  abort_global_ba();  // its snapshot predates this loop
+  const auto t0 = std::chrono::steady_clock::now();
+  LoopCorrectionResult corrected;
+  {
+    std::lock_guard map_lock(map_.update_mutex());
+    corrected = correct_loop(map_, *loop, options_.correction);
+  }
+  const double ms = ms_since(t0);
+  detector_.reset();
+  last_loop_keyframe_ = kf->id();
+  LoopRecord rec;
+  rec.frame = kf->frame_id();
+  rec.keyframe = kf->id();
+  rec.matched_keyframe = loop->candidate->id();
+  rec.matched_frame = loop->candidate->frame_id();
+  rec.inliers = loop->inliers;
+  rec.fused_points = corrected.fused_points;
+  rec.fused_lines = corrected.fused_lines;
+  rec.correction_ms = ms;
+  spdlog::info("loop closed: frame {} (keyframe {}) -> frame {} (keyframe {}), {} inliers, fused {} points and {} "
+               "lines, {} loop edges, {:.0f} ms",
+               rec.frame, rec.keyframe, rec.matched_frame, rec.matched_keyframe, rec.inliers, rec.fused_points,
+               rec.fused_lines, corrected.graph.loop_edges, ms);
+  {
+    std::lock_guard lock(stats_mutex_);
+    stats_.loops.push_back(rec);
+  }
+  if (!options_.global_ba) return;
+  if (!thread_.joinable()) {  // sequential: in the caller, for reproducible runs
+    global_ba();
+    return;
+  }
+  {
+    std::lock_guard lock(gba_mutex_);
+    gba_running_ = true;
+  }
+  gba_thread_ = std::thread([this] {
+    core::lower_this_thread_priority(kBackgroundNice);
+    global_ba();
+    {
+      std::lock_guard lock(gba_mutex_);
+      gba_running_ = false;
+    }
+    gba_cv_.notify_all();
+  });
+}
+
+}  // namespace plslam::loop

@@ -1,0 +1,125 @@
+#pragma once
+// The loop-closing thread (ORB-SLAM2's LoopClosing): local mapping hands it each keyframe it has
+// processed; it detects a revisited place (loop_detector.h), verifies it in SE(3)
+// (loop_verifier.h), confirms it by projecting the place's map points into the keyframe and
+// refining the pose over their reprojection errors, and corrects the map (loop_correction.h)
+// while local mapping is paused and tracking waits on the map's update lock.
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "plslam/loop/global_ba.h"
+#include "plslam/loop/loop_correction.h"
+#include "plslam/loop/loop_detector.h"
+#include "plslam/loop/loop_verifier.h"
+#include "plslam/mapping/local_mapper.h"
+#include "plslam/place/keyframe_database.h"
+
+namespace plslam::loop {
+
+struct LoopClosingOptions {
+  LoopDetectorOptions detector;
+  LoopVerifierOptions verifier;
+  LoopCorrectionOptions correction;
+  // After the place's map points are projected into the keyframe and the pose refined over their
+  // reprojection errors, this many must be inliers (ORB-SLAM2: 40).
+  int min_projection_inliers = 40;
+  double projection_radius = 10;  // pixels at the predicted level (ORB-SLAM2: 10)
+  // Plausibility: odometry drifts by a few percent of the distance travelled at most, so a loop
+  // that would move the keyframe by more than max_drift_ratio of the path from the recognised
+  // place (plus min_drift_m), or turn it by more than max_drift_deg, is perceptual aliasing that
+  // geometry could not tell apart (repeated textures at another place of a corridor).
+  double max_drift_ratio = 0.05;
+  double min_drift_m = 0.3;
+  double max_drift_deg = 10;
+  // No new loop within this many keyframes of the last one (ORB-SLAM2: 10).
+  int keyframes_between_loops = 10;
+  // Global BA after each loop, in its own thread (in the caller's with process_pending()).
+  bool global_ba = true;
+  GlobalBaOptions global_ba_options;
+  // At the end of a run, how long finish() waits for a running global BA before aborting it.
+  double finish_wait_s = 120;
+  // Throws std::invalid_argument naming the bad field.
+  void validate() const;
+};
+
+struct LoopRecord {
+  long frame = 0;             // the query keyframe's frame
+  long keyframe = 0;          // its id
+  long matched_keyframe = 0;  // the recognised place's keyframe
+  long matched_frame = 0;
+  int inliers = 0;            // after the projection search and refinement
+  int fused_points = 0;
+  int fused_lines = 0;
+  double correction_ms = 0;
+};
+
+struct LoopClosingStats {
+  std::vector<LoopRecord> loops;
+  int detections = 0;     // candidates the detector passed on
+  int rejected = 0;       // of them, failed verification, the projection or the plausibility check
+  int implausible = 0;    // of the rejected, those that passed the geometry but not plausibility
+  std::vector<double> global_ba_ms;  // per merged global BA: snapshot, optimisation and merge
+  int global_ba_runs = 0;            // merged
+  int global_ba_aborted = 0;         // made obsolete by a newer loop, or cut at finish()
+};
+
+class LoopCloser {
+ public:
+  LoopCloser(map::Map& map, const place::KeyframeDatabase& database, mapping::LocalMapper& mapper,
+             LoopClosingOptions options);
+  ~LoopCloser();
+  LoopCloser(const LoopCloser&) = delete;
+  LoopCloser& operator=(const LoopCloser&) = delete;
+
+  void start();
+  // Processes what is queued, then stops and joins.
+  void stop();
+  void insert(map::KeyFrame* kf);
+  // Processes every queued keyframe in the calling thread (sequential mode and tests).
+  void process_pending();
+  void wait_idle();
+  // wait_idle(), then waits up to options.finish_wait_s for a running global BA (aborting it after
+  // that, with a warning); returns false if it had to abort.
+  bool finish();
+  LoopClosingStats stats() const;
+
+ private:
+  void run();
+  void process(map::KeyFrame* kf);
+  // Verification and the projection check; the constraint to correct with, if the place holds.
+  std::optional<LoopConstraint> confirm(map::KeyFrame* kf, const LoopDetection& d);
+  // Whether moving the query to T_qw_corrected is within what odometry drift can explain.
+  bool plausible(map::KeyFrame* query, map::KeyFrame* candidate, const geometry::SE3& T_qw_corrected);
+  // Snapshot, optimise, merge (unless aborted).
+  void global_ba();
+  void abort_global_ba();
+
+  map::Map& map_;
+  const place::KeyframeDatabase& database_;
+  mapping::LocalMapper& mapper_;
+  LoopClosingOptions options_;
+  LoopDetector detector_;
+  long last_loop_keyframe_ = -1;
+
+  mutable std::mutex queue_mutex_;
+  std::condition_variable cv_;
+  std::deque<map::KeyFrame*> queue_;
+  bool busy_ = false;
+  bool stop_requested_ = false;
+  std::thread thread_;
+
+  std::thread gba_thread_;
+  std::atomic<bool> gba_abort_{false};
+  std::mutex gba_mutex_;
+  std::condition_variable gba_cv_;
+  bool gba_running_ = false;
+
+  mutable std::mutex stats_mutex_;
+  LoopClosingStats stats_;
+};
+
+}  // namespace plslam::loop

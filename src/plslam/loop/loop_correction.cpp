@@ -1,0 +1,189 @@
+#include "plslam/loop/loop_correction.h"
+
+#include <vector>
+
+namespace plslam::loop {
+namespace {
+
+using map::IdMap;
+using map::IdSet;
+using map::KeyFrame;
+using map::MapLine;
+using map::MapPoint;
+
+// The keyframe a landmark moves with: the one that corrected it, else its reference, else any
+// good observer (a culled reference).
+template <class L>
+KeyFrame* anchor_of(L* l, const IdMap<L, KeyFrame*>& corrected_by, const IdMap<KeyFrame, geometry::SE3>& poses) {
+  if (const auto it = corrected_by.find(l); it != corrected_by.end()) return it->second;
+  KeyFrame* ref = l->reference();
+  if (ref && !ref->is_bad() && poses.count(ref)) return ref;
+  for (const auto& [kf, idx] : l->observations()) {
+    if (!kf->is_bad() && poses.count(kf)) return kf;
+  }
+  return nullptr;
+}
+
+// Landmarks seen by the recognised place: the candidate and its covisible keyframes.
+template <class L>
+std::vector<L*> place_landmarks(const std::vector<KeyFrame*>& place, std::vector<L*> (KeyFrame::*get)() const) {
+  IdSet<L> seen;
+  std::vector<L*> out;
+  for (KeyFrame* kf : place) {
+    for (L* l : (kf->*get)()) {
+      if (l && !l->is_bad() && seen.insert(l).second) out.push_back(l);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, const LoopCorrectionOptions& o) {
+  o.graph.validate();
+  LoopCorrectionResult r;
+  KeyFrame* query = loop.query;
+  KeyFrame* candidate = loop.candidate;
+  query->update_connections();
+
+  // 1. Poses before the correction, and the query's neighbourhood moved by the verified pose.
+  EssentialGraphInput graph;
+  graph.keyframes = map.keyframes();
+  graph.query = query;
+  graph.candidate = candidate;
+  for (KeyFrame* kf : graph.keyframes) graph.odometry[kf] = graph.initial[kf] = kf->pose();
+  std::vector<KeyFrame*> neighbourhood{query};
+  for (KeyFrame* kf : query->covisibles()) {
+    if (!kf->is_bad() && kf != candidate) neighbourhood.push_back(kf);
+  }
+  const geometry::SE3 T_qw_corrected = (loop.T_query_candidate * candidate->pose()).normalized();
+  const geometry::SE3 T_wq = query->pose_inverse();
+  for (KeyFrame* kf : neighbourhood) {
+    graph.initial[kf] = (kf->pose() * T_wq * T_qw_corrected).normalized();
+  }
+  r.neighbourhood = static_cast<int>(neighbourhood.size());
+
+  // 2. Their landmarks, each with the first neighbourhood keyframe that sees it.
+  IdMap<MapPoint, KeyFrame*> point_corrected_by;
+  IdMap<MapLine, KeyFrame*> line_corrected_by;
+  for (KeyFrame* kf : neighbourhood) {
+    const geometry::SE3 M = graph.initial.at(kf).inverse() * graph.odometry.at(kf);  // old world -> corrected world
+    for (MapPoint* p : kf->map_points()) {
+      if (!p || p->is_bad() || !point_corrected_by.emplace(p, kf).second) continue;
+      p->set_position(M * p->position());
+    }
+    for (MapLine* l : kf->map_lines()) {
+      if (!l || l->is_bad() || !line_corrected_by.emplace(l, kf).second) continue;
+      l->set_endpoints(M * l->start(), M * l->end());
+    }
+    kf->set_pose(graph.initial.at(kf));
+  }
+
+  // 3. Fusion: the verified matches, then the place's landmarks projected into the neighbourhood.
+  // The place's landmark stays: it is anchored to the side of the loop that does not move.
+  for (const auto& [qp, cp] : loop.matches) {
+    if (qp != cp && !qp->is_bad() && !cp->is_bad()) {
+      qp->replace_with(cp);
+      ++r.fused_points;
+    }
+  }
+  std::vector<KeyFrame*> place{candidate};
+  for (KeyFrame* kf : candidate->covisibles()) {
+    if (!kf->is_bad()) place.push_back(kf);
+  }
+  const auto place_points = place_landmarks<MapPoint>(place, &KeyFrame::map_points);
+  const auto place_lines = o.lines ? place_landmarks<MapLine>(place, &KeyFrame::map_lines) : std::vector<MapLine*>{};
+  for (KeyFrame* kf : neighbourhood) {
+    const geometry::SE3 T = kf->pose();
+    const Eigen::Vector3d O = kf->camera_center();
+    for (MapPoint* p : place_points) {
+      if (p->is_bad() || p->index_in(kf) >= 0) continue;
+      const int j = mapping::match_point_in_keyframe(*kf, T, O, *p, o.fusion);
+      if (j < 0) continue;
+      MapPoint* there = kf->map_point(j);
+      if (there && !there->is_bad()) {
+        there->replace_with(p);
+        ++r.fused_points;
+      } else {
+        p->add_observation(kf, j);
+        kf->add_map_point(p, j);
+        ++r.added_points;
+      }
+    }
+    for (MapLine* l : place_lines) {
+      if (l->is_bad() || l->index_in(kf) >= 0) continue;
+      const int j = mapping::match_line_in_keyframe(*kf, T, *l, o.fusion);
+      if (j < 0) continue;
+      MapLine* there = kf->map_line(j);
+      if (there && !there->is_bad()) {
+        there->replace_with(l);
+        ++r.fused_lines;
+      } else {
+        l->add_observation(kf, j);
+        kf->add_map_line(l, j);
+        ++r.added_lines;
+      }
+    }
+  }
+  for (MapPoint* p : place_points) {
+    if (!p->is_bad()) {
+      p->update_descriptor();
+      p->update_normal_and_depth();
+    }
+  }
+  for (MapLine* l : place_lines) {
+    if (!l->is_bad()) {
+      l->update_descriptor();
+      l->refit_to_observations();  // the fused observations may extend it
+      l->update_normal_and_depth();
+    }
+  }
+
+  // 4. The connections the fusion made across the loop.
+  IdSet<KeyFrame> neighbourhood_set(neighbourhood.begin(), neighbourhood.end());
+  for (KeyFrame* kf : neighbourhood) {
+    IdSet<KeyFrame> before;
+    for (KeyFrame* c : kf->covisibles()) before.insert(c);
+    kf->update_connections();
+    for (KeyFrame* c : kf->covisibles()) {
+      if (!before.count(c) && !neighbourhood_set.count(c)) {
+        graph.loop_connections[kf].insert(c);
+        ++r.loop_connections;
+      }
+    }
+  }
+  graph.loop_connections[query].insert(candidate);
+
+  // 5. The essential graph, then every landmark with its anchor keyframe.
+  r.graph = optimize_essential_graph(graph, o.graph);
+  if (!r.graph.usable) return r;
+  for (KeyFrame* kf : graph.keyframes) kf->set_pose(r.graph.poses.at(kf));
+  // A landmark's anchor moved from `initial` to the optimised pose; it keeps its place in the
+  // anchor's camera frame.
+  auto motion_of = [&](KeyFrame* anchor) {
+    return (r.graph.poses.at(anchor).inverse() * graph.initial.at(anchor)).normalized();
+  };
+  for (MapPoint* p : map.points()) {
+    if (p->is_bad()) continue;
+    KeyFrame* anchor = anchor_of(p, point_corrected_by, r.graph.poses);
+    if (!anchor) continue;
+    p->set_position(motion_of(anchor) * p->position());
+    p->update_normal_and_depth();
+  }
+  for (MapLine* l : map.lines()) {
+    if (l->is_bad()) continue;
+    KeyFrame* anchor = anchor_of(l, line_corrected_by, r.graph.poses);
+    if (!anchor) continue;
+    const geometry::SE3 M = motion_of(anchor);
+    l->set_endpoints(M * l->start(), M * l->end());
+    l->update_normal_and_depth();
+  }
+
+  // 6. The loop edge, kept for every later essential graph.
+  query->add_loop_edge(candidate);
+  candidate->add_loop_edge(query);
+  map.note_big_change();
+  return r;
+}
+
+}  // namespace plslam::loop

@@ -1,0 +1,40 @@
+#pragma once
+// A bundle-adjustment problem built from map objects, with the way back from its arrays to the
+// objects: local BA (a window of keyframes) and global BA (all of them) both fill one.
+#include <unordered_map>
+#include <vector>
+
+#include "plslam/map/keyframe.h"
+#include "plslam/map/map_line.h"
+#include "plslam/map/map_point.h"
+#include "plslam/optim/bundle_adjustment.h"
+
+namespace plslam::mapping {
+
+class MapBaProblem {
+ public:
+  // line_information and far_stereo_baselines as LocalMapperOptions; lines false: points only.
+  MapBaProblem(double line_information, double far_stereo_baselines, bool lines);
+
+  // Adds the keyframe once, with its current pose; returns its index.
+  int add_keyframe(map::KeyFrame* kf, bool fixed);
+  // The points (and lines) these keyframes see, each once, with every observation by a good
+  // keyframe; observers not added yet join as fixed keyframes.
+  void add_landmarks_of(const std::vector<map::KeyFrame*>& keyframes);
+
+  optim::BaProblem problem;
+  std::vector<map::KeyFrame*> keyframes;  // indexed like problem.keyframes
+  std::vector<map::MapPoint*> points;     // like problem.points
+  std::vector<map::MapLine*> lines;       // like problem.lines
+  // Per observation (like problem.point_observations / line_observations): the observer.
+  std::vector<map::KeyFrame*> point_observers;
+  std::vector<map::KeyFrame*> line_observers;
+
+ private:
+  double line_information_;
+  double far_stereo_baselines_;
+  bool with_lines_;
+  std::unordered_map<const map::KeyFrame*, int> index_;
+};
+
+}  // namespace plslam::mapping

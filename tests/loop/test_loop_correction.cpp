@@ -1,0 +1,243 @@
+// Loop correction, the essential graph, the global BA merge and the loop-closing thread, on maps
+// with exact ground truth: a ring of poses with a known loop error, and the circling camera of
+// loop_scene.h whose second lap drifted.
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "loop/loop_scene.h"
+#include "plslam/loop/essential_graph.h"
+#include "plslam/loop/global_ba.h"
+#include "plslam/loop/loop_closer.h"
+#include "plslam/loop/loop_correction.h"
+#include "plslam/mapping/local_mapper.h"
+
+namespace plslam::loop {
+namespace {
+
+using namespace test;  // NOLINT: the scene's names
+
+double angle_deg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180 / std::numbers::pi; }
+
+// Camera-centre distance and rotation angle between two T_cw.
+std::pair<double, double> pose_error(const geometry::SE3& a, const geometry::SE3& b) {
+  const geometry::SE3 d = a.inverse() * b;
+  return {(a.inverse().translation() - b.inverse().translation()).norm(), angle_deg(d.rotation())};
+}
+
+TEST(EssentialGraph, SpreadsTheLoopErrorAndMeetsTheLoopConstraint) {
+  // 40 keyframes on a 20 m ring; odometry drifted by 4 degrees of yaw and 1 m along the way, each
+  // step a little (a random walk would be the same, only noisier). The last keyframe recognises
+  // the first: the loop measures the true relative pose.
+  constexpr int n = 40;
+  map::Map map;
+  auto data = std::make_shared<map::FrameData>();
+  data->calib = calibration();
+  std::vector<geometry::SE3> truth, odometry;
+  for (int k = 0; k < n; ++k) {
+    const double a = 2 * std::numbers::pi * k / n;
+    const Eigen::Matrix3d R_wc = Eigen::AngleAxisd(-a, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    truth.push_back(geometry::SE3(R_wc, Eigen::Vector3d(20 * std::sin(a), 0, 20 * (1 - std::cos(a)))).inverse());
+    const double f = static_cast<double>(k) / (n - 1);
+    const geometry::SE3 D(Eigen::AngleAxisd(f * 4 * std::numbers::pi / 180, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                          Eigen::Vector3d(f * 1.0, 0, 0));
+    odometry.push_back(truth.back() * D);
+  }
+  EssentialGraphInput in;
+  for (int k = 0; k < n; ++k) {
+    map::KeyFrame* kf = map.create_keyframe(data, odometry[static_cast<std::size_t>(k)]);
+    if (k > 0) kf->change_parent(in.keyframes.back());
+    in.keyframes.push_back(kf);
+    in.odometry[kf] = in.initial[kf] = odometry[static_cast<std::size_t>(k)];
+  }
+  in.candidate = in.keyframes.front();
+  in.query = in.keyframes.back();
+  const geometry::SE3 Z = truth.back() * truth.front().inverse();  // what verification measures
+  in.initial[in.query] = Z * odometry.front();
+  in.loop_connections[in.query].insert(in.candidate);
+
+  const auto r = optimize_essential_graph(in);
+  ASSERT_TRUE(r.usable);
+  EXPECT_EQ(r.edges, n);  // the spanning tree and the loop
+  EXPECT_EQ(r.loop_edges, 1);
+  const auto loop_before = pose_error(odometry.back() * odometry.front().inverse(), Z);
+  const auto loop_after = pose_error(r.poses.at(in.query) * r.poses.at(in.candidate).inverse(), Z);
+  EXPECT_GT(loop_before.first, 0.9);
+  // The loop constraint is met up to its share of the error (one edge of n for the translation;
+  // rotation and translation trade off with the lever arm of the ring, so a larger share there).
+  EXPECT_LT(loop_after.first, 2.0 * loop_before.first / n);
+  EXPECT_LT(loop_after.second, 0.15 * loop_before.second);
+  // Spread: every odometry edge takes a similar small share, none the whole error.
+  double max_edge = 0, sum_edge = 0;
+  for (int k = 1; k < n; ++k) {
+    const auto* a = in.keyframes[static_cast<std::size_t>(k - 1)];
+    const auto* b = in.keyframes[static_cast<std::size_t>(k)];
+    const geometry::SE3 measured = odometry[static_cast<std::size_t>(k - 1)] * odometry[static_cast<std::size_t>(k)].inverse();
+    const double e = pose_error(r.poses.at(const_cast<map::KeyFrame*>(a)) * r.poses.at(const_cast<map::KeyFrame*>(b)).inverse(), measured).first;
+    max_edge = std::max(max_edge, e);
+    sum_edge += e;
+  }
+  EXPECT_LT(max_edge, 3.0 * sum_edge / (n - 1));
+  EXPECT_LT(max_edge, 0.2 * loop_before.first);
+  // The candidate anchors the map; the far side moved towards the truth.
+  EXPECT_EQ(pose_error(r.poses.at(in.candidate), odometry.front()).first, 0.0);
+  double before = 0, after = 0;
+  for (int k = 0; k < n; ++k) {
+    before += pose_error(odometry[static_cast<std::size_t>(k)], truth[static_cast<std::size_t>(k)]).first;
+    after += pose_error(r.poses.at(in.keyframes[static_cast<std::size_t>(k)]), truth[static_cast<std::size_t>(k)]).first;
+  }
+  EXPECT_LT(after, before / 3);
+  EssentialGraphOptions bad;
+  bad.min_covisibility_weight = 0;
+  EXPECT_THROW(optimize_essential_graph(in, bad), std::invalid_argument);
+}
+
+// Every keyframe within 2 cm and 0.2 degrees of the truth.
+void expect_on_truth(const Scene& s, const char* when) {
+  for (std::size_t k = 0; k < s.keyframes.size(); ++k) {
+    if (s.keyframes[k]->is_bad()) continue;
+    const auto [dt, dr] = pose_error(s.keyframes[k]->pose(), true_pose(static_cast<int>(k)));
+    EXPECT_LT(dt, 0.02) << when << ": keyframe " << k;
+    EXPECT_LT(dr, 0.2) << when << ": keyframe " << k;
+  }
+}
+
+TEST(LoopCorrection, MovesTheSecondLapOntoTheFirstAndFusesItsPoints) {
+  Scene s;
+  for (int k = 0; k < kKeyframes; ++k) s.add_keyframe(k);
+  map::KeyFrame* query = s.keyframes[kPerLap + 10];
+  map::KeyFrame* candidate = s.keyframes[10];
+  const auto c = verify_loop(query, candidate, *s.db);
+  ASSERT_TRUE(c);
+  const auto first_lap_pose = s.keyframes[3]->pose();
+  const auto r = correct_loop(s.map, *c);
+  ASSERT_TRUE(r.graph.usable);
+  EXPECT_GT(r.neighbourhood, 5);
+  EXPECT_GT(r.fused_points, 200);
+  EXPECT_GT(r.loop_connections, 5);
+  EXPECT_EQ(s.map.big_changes(), 1);
+  expect_on_truth(s, "after the correction");
+  EXPECT_LT(pose_error(s.keyframes[3]->pose(), first_lap_pose).first, 1e-9) << "the recognised side does not move";
+  // The query's points are now the first lap's.
+  int own = 0, first_lap = 0;
+  for (map::MapPoint* p : query->map_points()) {
+    if (!p) continue;
+    (p->created_frame() < kPerLap ? first_lap : own)++;
+  }
+  EXPECT_GT(first_lap, 3 * own);
+  EXPECT_EQ(query->loop_edges().count(candidate), 1u);
+  EXPECT_EQ(candidate->loop_edges().count(query), 1u);
+  // Every second-lap point that survived sits on its true position.
+  for (const auto& [key, p] : s.instance) {
+    if (key.first != 1 || p->is_bad()) continue;
+    EXPECT_LT((p->position() - s.points[static_cast<std::size_t>(key.second)]).norm(), 0.05) << "point " << key.second;
+  }
+}
+
+TEST(GlobalBa, MergeKeepsWhatTheMapGainedDuringTheBaAttachedToItsParent) {
+  Scene s;
+  for (int k = 0; k < 20; ++k) s.add_keyframe(k);
+  // Noisy keyframe poses for the BA to fix (the first stays: it holds the gauge).
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0, 0.01);
+  for (int k = 1; k < 20; ++k) {
+    const geometry::SE3 d(geometry::so3_exp(Eigen::Vector3d(noise(rng), noise(rng), noise(rng)) * 0.2),
+                          Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+    s.keyframes[static_cast<std::size_t>(k)]->set_pose(d * s.keyframes[static_cast<std::size_t>(k)]->pose());
+  }
+  GlobalBaOptions o;
+  o.iterations = 20;
+  const auto snapshot = snapshot_for_global_ba(s.map, o);
+  // The map grows while the BA runs: keyframes 20-24, and the points they see first.
+  for (int k = 20; k < 25; ++k) s.add_keyframe(k);
+  std::vector<std::pair<map::KeyFrame*, geometry::SE3>> relative;  // new keyframe, T_c,parent
+  for (int k = 20; k < 25; ++k) {
+    map::KeyFrame* kf = s.keyframes[static_cast<std::size_t>(k)];
+    ASSERT_TRUE(kf->parent());
+    relative.emplace_back(kf, kf->pose() * kf->parent()->pose_inverse());
+  }
+  std::vector<std::pair<map::MapPoint*, Eigen::Vector3d>> new_points;  // in its reference's camera frame
+  for (map::MapPoint* p : s.map.points()) {
+    if (p->created_frame() >= 20) new_points.emplace_back(p, p->reference()->pose() * p->position());
+  }
+  ASSERT_FALSE(new_points.empty());
+  const auto result = run_global_ba(snapshot, o);
+  ASSERT_TRUE(result.usable);
+  EXPECT_FALSE(result.aborted);
+  // The noise was 1 cm and 0.1 degrees; what remains is what 0.2 px of pixel noise allows.
+  EXPECT_LT(result.final_cost, result.initial_cost / 5);
+  const auto merged = merge_global_ba(s.map, snapshot, result);
+  EXPECT_EQ(merged.keyframes, 20);
+  EXPECT_EQ(merged.propagated_keyframes, 5);
+  EXPECT_EQ(merged.moved_points, static_cast<int>(new_points.size()));
+  for (int k = 0; k < 20; ++k) {
+    const auto [dt, dr] = pose_error(s.keyframes[static_cast<std::size_t>(k)]->pose(), result.poses[static_cast<std::size_t>(k)]);
+    EXPECT_LT(dt, 1e-9) << "keyframe " << k;
+    EXPECT_LT(dr, 1e-6) << "keyframe " << k;
+  }
+  for (const auto& [kf, T_cp] : relative) {
+    const auto [dt, dr] = pose_error(kf->pose() * kf->parent()->pose_inverse(), T_cp);
+    EXPECT_LT(dt, 1e-9) << "keyframe " << kf->id();
+    EXPECT_LT(dr, 1e-6) << "keyframe " << kf->id();
+  }
+  for (const auto& [p, in_ref] : new_points) {
+    EXPECT_LT((p->reference()->pose() * p->position() - in_ref).norm(), 1e-9);
+  }
+  EXPECT_EQ(s.map.big_changes(), 1);
+
+  // An abort raised before the BA starts leaves it at its initial state, flagged.
+  std::atomic<bool> abort{true};
+  const auto aborted = run_global_ba(snapshot_for_global_ba(s.map, o), o, &abort);
+  EXPECT_TRUE(aborted.aborted);
+  EXPECT_EQ(aborted.iterations, 0);
+}
+
+// The loop-closing thread's whole path: detection, verification with the projection check,
+// correction and global BA, fed keyframe by keyframe as local mapping would.
+void close_the_scene_loop(bool threaded) {
+  Scene s;
+  mapping::LocalMapper mapper(s.map, {});  // never started: only its pause is used
+  LoopClosingOptions o;
+  LoopCloser closer(s.map, *s.db, mapper, o);
+  if (threaded) closer.start();
+  std::atomic<bool> done{false};
+  // A reader standing in for tracking: poses under the update lock, as Tracker::track does.
+  std::thread reader([&] {
+    while (!done) {
+      std::lock_guard lock(s.map.update_mutex());
+      for (map::KeyFrame* kf : s.map.keyframes()) (void)kf->pose();
+    }
+  });
+  for (int k = 0; k < kKeyframes; ++k) {
+    closer.insert(s.add_keyframe(k));
+    if (!threaded) closer.process_pending();
+  }
+  EXPECT_TRUE(closer.finish());
+  closer.stop();
+  done = true;
+  reader.join();
+  const auto st = closer.stats();
+  // In the caller's thread one loop closes it all. In its own thread, keyframes that queued
+  // behind the loop and lie outside its neighbourhood may find the place once more, ten
+  // keyframes later (keyframes_between_loops); that second correction is then a small one.
+  ASSERT_GE(st.loops.size(), 1u);
+  ASSERT_LE(st.loops.size(), threaded ? 2u : 1u);
+  for (const auto& l : st.loops) {
+    EXPECT_GE(l.keyframe, kPerLap);
+    EXPECT_LE(std::abs(l.matched_frame - (l.frame - kPerLap)), 3);
+    EXPECT_GE(l.inliers, o.min_projection_inliers);
+  }
+  EXPECT_EQ(st.global_ba_runs + st.global_ba_aborted, static_cast<int>(st.loops.size()));
+  EXPECT_EQ(st.global_ba_runs, 1);  // the last one always finishes
+  expect_on_truth(s, threaded ? "threaded" : "in the caller's thread");
+}
+
+TEST(LoopClosing, ClosesTheSecondLapOnceInTheCallersThread) { close_the_scene_loop(false); }
+
+TEST(LoopClosingConcurrent, ClosesTheSecondLapOnceInItsOwnThreadWhileTrackingReads) { close_the_scene_loop(true); }
+
+}  // namespace
+}  // namespace plslam::loop
