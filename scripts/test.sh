@@ -81,5 +81,13 @@ cmake --build "$BUILD_DIR" -j"$(nproc)" ${build_targets[@]+"${build_targets[@]}"
 ctest_args=(--test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)")
 if [ -z "$tests_regex" ] && [ "$sanitize" = thread ]; then tests_regex=$TSAN_TESTS; fi
 if [ -n "$tests_regex" ]; then ctest_args+=(-R "$tests_regex"); fi
-if [ -n "$sanitize" ]; then ctest_args+=(-E "$SANITIZER_SKIP"); fi
+# Under ThreadSanitizer the rendered office run of RunConcurrent is left out as well:
+# LoopClosingConcurrent.RenderedOfficeLoopClosesAtTheRevisitOnly runs the same threads on the same
+# scene, with loop closing and its global BA on top (109 s of the stage).
+TSAN_SKIP='^RunConcurrent\.SyntheticOfficeWithLocalMappingThread$'
+if [ "$sanitize" = thread ]; then
+  ctest_args+=(-E "$SANITIZER_SKIP|$TSAN_SKIP")
+elif [ -n "$sanitize" ]; then
+  ctest_args+=(-E "$SANITIZER_SKIP")
+fi
 ctest "${ctest_args[@]}"
