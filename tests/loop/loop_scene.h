@@ -79,7 +79,9 @@ struct Scene {
   }
 
   // Keyframe k observes every point in view; the second lap's keyframes get their own map points.
-  map::KeyFrame* add_keyframe(int k) {
+  // Unmapped: as tracking leaves a keyframe in local mapping's queue, its new points observed by it
+  // and the points it tracked only listed, with no connections and not in the database.
+  map::KeyFrame* add_keyframe(int k, bool mapped = true) {
     const int lap = k / kPerLap;
     const geometry::SE3 T = true_pose(k);
     const geometry::StereoCamera cam(calibration());
@@ -124,8 +126,9 @@ struct Scene {
         const Eigen::Vector3d& P = points[static_cast<std::size_t>(ids[j])];
         mp = map.create_point(drifted ? drift() * P : P, kf, k);
         instance[{lap, ids[j]}] = mp;
+        if (!mapped) mp->add_observation(kf, static_cast<int>(j));
       }
-      mp->add_observation(kf, static_cast<int>(j));
+      if (mapped) mp->add_observation(kf, static_cast<int>(j));
       kf->add_map_point(mp, static_cast<int>(j));
       // Descriptor and distance range, for the projection searches of loop closing.
       if (mp->num_observations() <= 2) {
@@ -133,8 +136,10 @@ struct Scene {
         mp->update_normal_and_depth();
       }
     }
-    kf->update_connections();
-    db->add(kf);
+    if (mapped) {
+      kf->update_connections();
+      db->add(kf);
+    }
     keyframes.push_back(kf);
     return kf;
   }

@@ -13,6 +13,7 @@
 #include "plslam/loop/global_ba.h"
 #include "plslam/loop/loop_closer.h"
 #include "plslam/loop/loop_correction.h"
+#include "plslam/loop/unmapped_keyframes.h"
 #include "plslam/mapping/local_mapper.h"
 
 namespace plslam::loop {
@@ -137,6 +138,30 @@ TEST(LoopCorrection, MovesTheSecondLapOntoTheFirstAndFusesItsPoints) {
   }
 }
 
+// Keyframes still waiting in local mapping's queue have no connections: without their anchor,
+// the second lap's last ones would stay 0.3 m off with the points tracking made from them.
+TEST(LoopCorrection, KeyframesStillQueuedForLocalMappingMoveWithTheirAnchor) {
+  Scene s;
+  for (int k = 0; k <= kPerLap + 10; ++k) s.add_keyframe(k);
+  for (int k = kPerLap + 11; k <= kPerLap + 12; ++k) s.add_keyframe(k, false);
+  const auto unmapped = unmapped_keyframes(s.map.keyframes());
+  ASSERT_EQ(unmapped.size(), 2u);
+  for (const auto& u : unmapped) EXPECT_EQ(u.anchor, s.keyframes[kPerLap + 10]);
+  const auto c = verify_loop(s.keyframes[kPerLap + 10], s.keyframes[10], *s.db);
+  ASSERT_TRUE(c);
+  const auto r = correct_loop(s.map, *c);
+  ASSERT_TRUE(r.graph.usable);
+  EXPECT_EQ(r.unmapped_keyframes, 2);
+  expect_on_truth(s, "after the correction");
+  int own = 0;
+  for (const auto& [key, p] : s.instance) {
+    if (key.first != 1 || p->is_bad() || p->created_frame() <= kPerLap + 10) continue;
+    ++own;
+    EXPECT_LT((p->position() - s.points[static_cast<std::size_t>(key.second)]).norm(), 0.05) << "point " << key.second;
+  }
+  EXPECT_GT(own, 0);
+}
+
 TEST(GlobalBa, MergeKeepsWhatTheMapGainedDuringTheBaAttachedToItsParent) {
   Scene s;
   for (int k = 0; k < 20; ++k) s.add_keyframe(k);
@@ -159,6 +184,9 @@ TEST(GlobalBa, MergeKeepsWhatTheMapGainedDuringTheBaAttachedToItsParent) {
     ASSERT_TRUE(kf->parent());
     relative.emplace_back(kf, kf->pose() * kf->parent()->pose_inverse());
   }
+  // And one local mapping has not processed yet: it keeps its pose relative to keyframe 24.
+  map::KeyFrame* queued = s.add_keyframe(25, false);
+  const geometry::SE3 queued_relative = queued->pose() * s.keyframes[24]->pose_inverse();
   std::vector<std::pair<map::MapPoint*, Eigen::Vector3d>> new_points;  // in its reference's camera frame
   for (map::MapPoint* p : s.map.points()) {
     if (p->created_frame() >= 20) new_points.emplace_back(p, p->reference()->pose() * p->position());
@@ -171,7 +199,8 @@ TEST(GlobalBa, MergeKeepsWhatTheMapGainedDuringTheBaAttachedToItsParent) {
   EXPECT_LT(result.final_cost, result.initial_cost / 5);
   const auto merged = merge_global_ba(s.map, snapshot, result);
   EXPECT_EQ(merged.keyframes, 20);
-  EXPECT_EQ(merged.propagated_keyframes, 5);
+  EXPECT_EQ(merged.propagated_keyframes, 6);
+  EXPECT_LT(pose_error(queued->pose() * s.keyframes[24]->pose_inverse(), queued_relative).first, 1e-9);
   EXPECT_EQ(merged.moved_points, static_cast<int>(new_points.size()));
   for (int k = 0; k < 20; ++k) {
     const auto [dt, dr] = pose_error(s.keyframes[static_cast<std::size_t>(k)]->pose(), result.poses[static_cast<std::size_t>(k)]);
@@ -187,6 +216,9 @@ TEST(GlobalBa, MergeKeepsWhatTheMapGainedDuringTheBaAttachedToItsParent) {
     EXPECT_LT((p->reference()->pose() * p->position() - in_ref).norm(), 1e-9);
   }
   EXPECT_EQ(s.map.big_changes(), 1);
+
+  // A snapshot leaves unmapped keyframes out (their points are seen by nothing else either).
+  EXPECT_EQ(snapshot_for_global_ba(s.map, o).problem->keyframes.size(), 25u);
 
   // An abort raised before the BA starts leaves it at its initial state, flagged.
   std::atomic<bool> abort{true};

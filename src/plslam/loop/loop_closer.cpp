@@ -323,9 +323,9 @@ void LoopCloser::process(map::KeyFrame* kf) {
   rec.fused_lines = corrected.fused_lines;
   rec.correction_ms = ms;
   spdlog::info("loop closed: frame {} (keyframe {}) -> frame {} (keyframe {}), {} inliers, fused {} points and {} "
-               "lines, {} loop edges, {:.0f} ms",
+               "lines, {} loop edges, {} keyframes still queued for mapping moved along, {:.0f} ms",
                rec.frame, rec.keyframe, rec.matched_frame, rec.matched_keyframe, rec.inliers, rec.fused_points,
-               rec.fused_lines, corrected.graph.loop_edges, ms);
+               rec.fused_lines, corrected.graph.loop_edges, corrected.unmapped_keyframes, ms);
   {
     std::lock_guard lock(stats_mutex_);
     stats_.loops.push_back(rec);

@@ -2,6 +2,8 @@
 
 #include <vector>
 
+#include "plslam/loop/unmapped_keyframes.h"
+
 namespace plslam::loop {
 namespace {
 
@@ -48,10 +50,16 @@ LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, con
 
   // 1. Poses before the correction, and the query's neighbourhood moved by the verified pose.
   EssentialGraphInput graph;
-  graph.keyframes = map.keyframes();
+  const auto keyframes = map.keyframes();
+  const auto unmapped = unmapped_keyframes(keyframes);
+  IdSet<KeyFrame> unmapped_set;
+  for (const auto& u : unmapped) unmapped_set.insert(u.keyframe);
+  for (KeyFrame* kf : keyframes) {
+    if (!unmapped_set.count(kf)) graph.keyframes.push_back(kf);
+    graph.odometry[kf] = graph.initial[kf] = kf->pose();
+  }
   graph.query = query;
   graph.candidate = candidate;
-  for (KeyFrame* kf : graph.keyframes) graph.odometry[kf] = graph.initial[kf] = kf->pose();
   std::vector<KeyFrame*> neighbourhood{query};
   for (KeyFrame* kf : query->covisibles()) {
     if (!kf->is_bad() && kf != candidate) neighbourhood.push_back(kf);
@@ -157,7 +165,11 @@ LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, con
   // 5. The essential graph, then every landmark with its anchor keyframe.
   r.graph = optimize_essential_graph(graph, o.graph);
   if (!r.graph.usable) return r;
-  for (KeyFrame* kf : graph.keyframes) kf->set_pose(r.graph.poses.at(kf));
+  for (const auto& [kf, anchor] : unmapped) {
+    r.graph.poses[kf] = (graph.odometry.at(kf) * graph.odometry.at(anchor).inverse() * r.graph.poses.at(anchor)).normalized();
+    ++r.unmapped_keyframes;
+  }
+  for (const auto& [kf, T] : r.graph.poses) kf->set_pose(T);
   // A landmark's anchor moved from `initial` to the optimised pose; it keeps its place in the
   // anchor's camera frame.
   auto motion_of = [&](KeyFrame* anchor) {

@@ -25,6 +25,7 @@ struct LoopCorrectionResult {
   int fused_lines = 0;
   int added_lines = 0;
   int loop_connections = 0;  // new keyframe pairs across the loop
+  int unmapped_keyframes = 0;  // still in local mapping's queue: moved with their anchor
   EssentialGraphResult graph;
 };
 
