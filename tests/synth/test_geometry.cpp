@@ -7,6 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "plslam/core/error.h"
 #include "plslam/synth/sequence.h"
 
 namespace plslam::synth {
@@ -199,6 +200,34 @@ TEST(SynthGeometry, TrajectoriesArePlausibleAndLoopsClose) {
       min_return = std::min(min_return, (seq.left_pose(i).translation() - first.translation()).norm());
     EXPECT_LT(min_return, c.max_speed > 2 ? 3.0 : 0.5);
   }
+}
+
+// --loop-overlap: after the return the camera travels that share of the path again, along the
+// first lap (a longer revisit, for loop-closing tests).
+TEST(SynthGeometry, LoopOverlapIsTravelledAgainAlongTheFirstLap) {
+  SequenceOptions o;
+  o.loop = true;
+  o.frames = 540;
+  o.loop_overlap = 0.15;
+  const Sequence seq(o);
+  const double T = (o.frames - 1) / o.preset.fps;
+  EXPECT_NEAR(seq.path().speed() * T, 1.15 * seq.path().length(), 1e-6);
+  // The last frame is where the first lap was after 15 % of the path (frame ~70), far from the start.
+  const Eigen::Vector3d last = seq.left_pose(seq.size() - 1).translation();
+  double nearest = 1e9;
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < seq.size() / 2; ++i) {
+    const double d = (seq.left_pose(i).translation() - last).norm();
+    if (d < nearest) nearest = d, at = i;
+  }
+  EXPECT_LT(nearest, 0.1);
+  EXPECT_NEAR(static_cast<double>(at), 0.15 / 1.15 * (o.frames - 1), 5);
+  EXPECT_GT((seq.left_pose(0).translation() - last).norm(), 3.0);
+  o.loop_overlap = 1.5;
+  EXPECT_THROW(Sequence{o}, InputError);
+  o.loop_overlap = 0.15;
+  o.frames = 480;  // 1.15 x 31 m in 24 s is faster than the office walk allows
+  EXPECT_THROW(Sequence{o}, InputError);
 }
 
 TEST(SynthGeometry, ExposureVariesWithinTwentyPercent) {

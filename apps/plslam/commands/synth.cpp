@@ -26,6 +26,8 @@ struct Options {
   int frames = 200;
   std::uint64_t seed = 1;
   bool loop = false;
+  double loop_overlap = plslam::synth::SequenceOptions{}.loop_overlap;
+  double fps = 0;  // 0: the preset's
   bool motion_blur = false;
   bool force = false;
   int threads = 0;
@@ -97,15 +99,17 @@ int run(const Options& o) {
   plslam::synth::SequenceOptions so;
   so.scene = plslam::synth::parse_scene_kind(o.scene);
   so.preset = plslam::synth::parse_preset(o.preset);
+  if (o.fps > 0) so.preset.fps = o.fps;
   so.frames = o.frames;
   so.seed = o.seed;
   so.loop = o.loop;
+  so.loop_overlap = o.loop_overlap;
   so.motion_blur = o.motion_blur;
   const auto format = plslam::synth::parse_output_format(o.format.empty() ? o.preset : o.format);
   const plslam::synth::Sequence seq(so);  // checks the options first: they are the likelier mistake
   const fs::path out = checked_out_folder(o.out, o.force);
   plslam::app::install_stop_signals();
-  spdlog::info("synth: {} scene, {} preset ({}x{} @ {} Hz, baseline {} m), {} frames, path {:.1f} m at {:.2f} m/s{}",
+  spdlog::info("synth: {} scene, {} preset ({}x{} @ {:.4g} Hz, baseline {} m), {} frames, path {:.1f} m at {:.2f} m/s{}",
                o.scene, so.preset.name, so.preset.width, so.preset.height, so.preset.fps, so.preset.baseline,
                o.frames, seq.path().length(), seq.path().speed(), o.loop ? ", loop" : "");
   const auto start = std::chrono::steady_clock::now();
@@ -142,10 +146,19 @@ plslam::cli::CommandRegistration reg({"synth", "Render a synthetic stereo sequen
                                         sub.add_option("--format", o->format, "euroc|kitti (default: the preset's)");
                                         sub.add_option("--preset", o->preset, "Camera preset: euroc|kitti")
                                             ->capture_default_str();
+                                        sub.add_option("--fps", o->fps,
+                                                       "Frame rate in Hz (default: the preset's; a lower one renders "
+                                                       "the same path with fewer, further-apart frames)")
+                                            ->check(CLI::Range(0.5, 1000.0));
                                         sub.add_option("--seed", o->seed, "Seed for textures and motion")
                                             ->check(CLI::NonNegativeNumber)
                                             ->capture_default_str();
-                                        sub.add_flag("--loop", o->loop, "Close a loop of >= 30 m and return to the start");
+                                        auto* loop = sub.add_flag("--loop", o->loop, "Close a loop of >= 30 m and return to the start");
+                                        sub.add_option("--loop-overlap", o->loop_overlap,
+                                                       "With --loop: share of the path travelled again after the return")
+                                            ->check(CLI::Range(0.0, 1.0))
+                                            ->capture_default_str()
+                                            ->needs(loop);
                                         sub.add_flag("--motion-blur", o->motion_blur, "Blur proportional to the motion");
                                         sub.add_flag("--force", o->force, "Replace a non-empty --out folder");
                                         sub.add_option("--threads", o->threads, "Rendering threads (0: all cores)")

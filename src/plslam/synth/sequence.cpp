@@ -22,19 +22,19 @@ CameraPreset parse_preset(const std::string& name) {
 
 namespace {
 
-// With --loop the whole closed path plus a little overlap is covered by the sequence.
-constexpr double kLoopOverlap = 1.03;
-
 double choose_speed(const Scene& scene, const SequenceOptions& o) {
   if (o.frames < 2) throw InputError("", "need at least 2 frames");
   if (!o.loop) return scene.nominal_speed;
+  // The whole closed path plus the overlap, travelled again after the return, is covered.
+  if (!(o.loop_overlap >= 0 && o.loop_overlap <= 1)) throw InputError("", "--loop-overlap must be in [0, 1]");
+  const double covered = 1 + o.loop_overlap;
   const double length = CameraPath(scene, 1.0, o.seed).length();
   const double duration = (o.frames - 1) / o.preset.fps;
-  const double speed = length * kLoopOverlap / duration;
+  const double speed = length * covered / duration;
   // Leave headroom for the hand-held sway and bobbing on top of the path speed.
   const double limit = scene.vehicle ? scene.max_speed : scene.max_speed - 0.1;
   if (speed > limit) {
-    const int needed = static_cast<int>(std::ceil(length * kLoopOverlap / limit * o.preset.fps)) + 1;
+    const int needed = static_cast<int>(std::ceil(length * covered / limit * o.preset.fps)) + 1;
     throw InputError("", fmt::format("--loop on the {} scene ({:.0f} m) needs at least {} frames at {} Hz",
                                      to_string(scene.kind), length, needed, o.preset.fps));
   }

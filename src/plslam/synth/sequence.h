@@ -35,6 +35,7 @@ struct SequenceOptions {
   int frames = 200;
   std::uint64_t seed = 1;
   bool loop = false;         // traverse the whole closed path (>= 30 m) and return to the start
+  double loop_overlap = 0.03;  // with loop: share of the path travelled again after the return, in [0, 1]
   bool motion_blur = false;  // integrate over the shutter time, proportional to the motion
 };
 

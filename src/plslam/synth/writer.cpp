@@ -105,7 +105,7 @@ void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const E
   io::write_trajectory(dir / "left_camera.tum", left, io::TrajectoryFormat::kTum);
   const auto& o = seq.options();
   nlohmann::json j = {{"scene", to_string(o.scene)}, {"preset", o.preset.name}, {"frames", o.frames},
-                      {"seed", o.seed},   {"loop", o.loop},  {"motion_blur", o.motion_blur},
+                      {"seed", o.seed},   {"loop", o.loop},  {"loop_overlap", o.loop_overlap}, {"motion_blur", o.motion_blur},
                       {"fps", o.preset.fps}, {"width", o.preset.width}, {"height", o.preset.height},
                       {"fx", o.preset.fx}, {"fy", o.preset.fy}, {"cx", o.preset.cx}, {"cy", o.preset.cy},
                       {"baseline_m", o.preset.baseline}, {"path_length_m", seq.path().length()},
