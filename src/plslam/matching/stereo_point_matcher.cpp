@@ -170,8 +170,12 @@ StereoPointMatches match_stereo_points(const features::PointFeatures& left,
     const double d1 = sad[static_cast<std::size_t>(best_inc + L - 1)];
     const double d2 = sad[static_cast<std::size_t>(best_inc + L)];
     const double d3 = sad[static_cast<std::size_t>(best_inc + L + 1)];
-    const double denom = 2.0 * (d1 + d3 - 2.0 * d2);
-    const double delta = denom > 0 ? (d1 - d3) / denom : 0.0;
+    // Equiangular (V) fit: a SAD curve is |x - delta|-shaped near its minimum, not quadratic. The
+    // parabola ORB-SLAM2 fits to it pulls the estimate to whole pixels ("pixel locking"): on
+    // synthetic planes +-0.1 px at fractions 0.2/0.8 and 0.10 px mean error at level 0, against
+    // +-0.03 and 0.03 px with this fit (tests/features/test_stereo_points.cpp).
+    const double slope = std::max(d1, d3) - d2;
+    const double delta = slope > 0 ? (d1 - d3) / (2.0 * slope) : 0.0;
     if (delta < -1.0 || delta > 1.0) {
       ++out.rejected.sad_edge;
       continue;

@@ -2,8 +2,8 @@
 // Stereo point matching for a rectified pair (ORB-SLAM2's scheme): for each left keypoint,
 // right keypoints in a row band (scaled by the pyramid level) and in the disparity range
 // [0, bf/z_min] compete by Hamming distance; the best one under a threshold is refined by SAD
-// on an 11x11 window with a parabola fit, and matches whose SAD is far above the median are
-// rejected.
+// on an 11x11 window with an equiangular (V) sub-pixel fit (ORB-SLAM2 fits a parabola), and
+// matches whose SAD is far above the median are rejected.
 #include <vector>
 
 #include "plslam/features/orb_extractor.h"
