@@ -122,13 +122,14 @@ struct Scene {
       };
       map::MapPoint* mp = resolve(lap);
       if (!mp && !drifted) mp = resolve(0);
-      if (!mp) {
+      const bool created = !mp;
+      if (created) {
         const Eigen::Vector3d& P = points[static_cast<std::size_t>(ids[j])];
         mp = map.create_point(drifted ? drift() * P : P, kf, k);
         instance[{lap, ids[j]}] = mp;
-        if (!mapped) mp->add_observation(kf, static_cast<int>(j));
       }
-      if (mapped) mp->add_observation(kf, static_cast<int>(j));
+      // Tracking observes the points it creates; local mapping adds the tracked ones.
+      if (mapped || created) mp->add_observation(kf, static_cast<int>(j));
       kf->add_map_point(mp, static_cast<int>(j));
       // Descriptor and distance range, for the projection searches of loop closing.
       if (mp->num_observations() <= 2) {

@@ -144,7 +144,9 @@ TEST(LoopCorrection, KeyframesStillQueuedForLocalMappingMoveWithTheirAnchor) {
   Scene s;
   for (int k = 0; k <= kPerLap + 10; ++k) s.add_keyframe(k);
   for (int k = kPerLap + 11; k <= kPerLap + 12; ++k) s.add_keyframe(k, false);
-  const auto unmapped = unmapped_keyframes(s.map.keyframes());
+  const auto split = split_unmapped(s.map.keyframes());
+  EXPECT_EQ(split.connected.size(), static_cast<std::size_t>(kPerLap + 11));
+  const auto& unmapped = split.unmapped;
   ASSERT_EQ(unmapped.size(), 2u);
   for (const auto& u : unmapped) EXPECT_EQ(u.anchor, s.keyframes[kPerLap + 10]);
   const auto c = verify_loop(s.keyframes[kPerLap + 10], s.keyframes[10], *s.db);

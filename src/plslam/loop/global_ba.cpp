@@ -17,15 +17,7 @@ GlobalBaSnapshot snapshot_for_global_ba(const map::Map& map, const GlobalBaOptio
   s.problem = std::make_unique<mapping::MapBaProblem>(o.line_information, o.far_stereo_baselines, o.lines);
   // Keyframes local mapping has not connected yet have no observations of the map's points: the
   // merge moves them with their anchors.
-  std::vector<map::KeyFrame*> keyframes;
-  {
-    const auto all = map.keyframes();
-    map::IdSet<map::KeyFrame> unmapped;
-    for (const auto& u : unmapped_keyframes(all)) unmapped.insert(u.keyframe);
-    for (map::KeyFrame* kf : all) {
-      if (!unmapped.count(kf)) keyframes.push_back(kf);
-    }
-  }
+  const auto keyframes = split_unmapped(map.keyframes()).connected;
   if (keyframes.empty()) return s;
   s.camera = geometry::StereoCamera(keyframes.front()->data().calib);
   for (map::KeyFrame* kf : keyframes) s.problem->add_keyframe(kf, kf == keyframes.front());
@@ -67,7 +59,7 @@ GlobalBaMergeStats merge_global_ba(map::Map& map, const GlobalBaSnapshot& s, con
       queue.push_back(child);
     }
   }
-  for (const auto& [kf, anchor] : unmapped_keyframes(map.keyframes())) {
+  for (const auto& [kf, anchor] : split_unmapped(map.keyframes()).unmapped) {
     if (after.count(kf) || !after.count(anchor)) continue;
     after[kf] = (before.at(kf) * before.at(anchor).inverse() * after.at(anchor)).normalized();
     ++st.propagated_keyframes;

@@ -50,14 +50,10 @@ LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, con
 
   // 1. Poses before the correction, and the query's neighbourhood moved by the verified pose.
   EssentialGraphInput graph;
-  const auto keyframes = map.keyframes();
-  const auto unmapped = unmapped_keyframes(keyframes);
-  IdSet<KeyFrame> unmapped_set;
-  for (const auto& u : unmapped) unmapped_set.insert(u.keyframe);
-  for (KeyFrame* kf : keyframes) {
-    if (!unmapped_set.count(kf)) graph.keyframes.push_back(kf);
-    graph.odometry[kf] = graph.initial[kf] = kf->pose();
-  }
+  auto [connected, unmapped] = split_unmapped(map.keyframes());
+  graph.keyframes = std::move(connected);
+  for (KeyFrame* kf : graph.keyframes) graph.odometry[kf] = graph.initial[kf] = kf->pose();
+  for (const auto& u : unmapped) graph.odometry[u.keyframe] = graph.initial[u.keyframe] = u.keyframe->pose();
   graph.query = query;
   graph.candidate = candidate;
   std::vector<KeyFrame*> neighbourhood{query};

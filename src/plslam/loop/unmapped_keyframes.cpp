@@ -2,18 +2,18 @@
 
 namespace plslam::loop {
 
-bool is_unmapped(const map::KeyFrame& kf) { return !kf.is_bad() && !kf.parent() && kf.covisibles().empty(); }
-
-std::vector<UnmappedKeyFrame> unmapped_keyframes(const std::vector<map::KeyFrame*>& keyframes) {
-  std::vector<UnmappedKeyFrame> out;
+KeyFramesByMapping split_unmapped(const std::vector<map::KeyFrame*>& keyframes) {
+  KeyFramesByMapping out;
   map::KeyFrame* latest_connected = nullptr;
   for (map::KeyFrame* kf : keyframes) {
     if (kf->is_bad()) continue;
-    if (!is_unmapped(*kf)) {
-      latest_connected = kf;
-    } else if (latest_connected) {
-      out.push_back({kf, latest_connected});
+    const bool unmapped = !kf->parent() && kf->covisibles().empty();
+    if (unmapped && latest_connected) {
+      out.unmapped.push_back({kf, latest_connected});
+      continue;
     }
+    out.connected.push_back(kf);
+    if (!unmapped) latest_connected = kf;
   }
   return out;
 }

@@ -16,10 +16,13 @@ struct UnmappedKeyFrame {
   map::KeyFrame* anchor;  // never null
 };
 
-bool is_unmapped(const map::KeyFrame& kf);
+struct KeyFramesByMapping {
+  std::vector<map::KeyFrame*> connected;  // in the input's order
+  std::vector<UnmappedKeyFrame> unmapped;
+};
 
-// `keyframes` in id order (Map::keyframes()). Unmapped keyframes with no connected keyframe before
-// them (a map's very first keyframe) have nothing to move with and are left out.
-std::vector<UnmappedKeyFrame> unmapped_keyframes(const std::vector<map::KeyFrame*>& keyframes);
+// `keyframes` in id order (Map::keyframes()). An unmapped keyframe with no connected keyframe
+// before it (a map's very first keyframe) has nothing to move with and counts as connected.
+KeyFramesByMapping split_unmapped(const std::vector<map::KeyFrame*>& keyframes);
 
 }  // namespace plslam::loop
