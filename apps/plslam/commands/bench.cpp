@@ -1,11 +1,13 @@
-// plslam bench <stage> <dataset>: per-stage timings of the front end on real frames.
+// plslam bench features <dataset>: per-stage timings of the front end on real frames.
 //   plslam bench features <dataset> [--frames N] [--json]
+// plslam bench slam <dataset>... --out DIR: the paper's experiments (bench_slam_command.h).
 #include <iostream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include "bench_slam_command.h"
 #include "command_registry.h"
 #include "commands/dataset_options.h"
 #include "json_stdout.h"
@@ -123,7 +125,7 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   return 0;
 }
 
-CommandRegistration reg({"bench", "Benchmark front-end stages on real frames", [](CLI::App& sub) {
+CommandRegistration reg({"bench", "Benchmarks: front-end stages (features), whole-system experiments (slam)", [](CLI::App& sub) {
                            sub.require_subcommand(1);
                            auto args = std::make_shared<BenchFeaturesArgs>();
                            CLI::App* features = sub.add_subcommand("features", "Point and line features: per-stage ms, counts, uniformity, whole-frame ms");
@@ -139,8 +141,13 @@ CommandRegistration reg({"bench", "Benchmark front-end stages on real frames", [
                                ->check(CLI::IsMember({"auto", "avx2", "sse2", "scalar", "opencv"}))->capture_default_str();
                            features->add_option("--right-factor", args->right_factor, "Right image keeps this many times more points")
                                ->check(CLI::Range(0.1, 100.0))->capture_default_str();
-                           return std::function<int()>([args, features] {
+                           auto slam_args = std::make_shared<BenchSlamArgs>();
+                           CLI::App* slam = sub.add_subcommand(
+                               "slam", "The paper's experiments: configurations x datasets x runs, anchors, report and figures");
+                           add_bench_slam_options(*slam, *slam_args);
+                           return std::function<int()>([args, features, slam, slam_args] {
                              if (features->parsed()) return run_bench_features(*args);
+                             if (slam->parsed()) return run_bench_slam(*slam_args);
                              return 2;
                            });
                          }});

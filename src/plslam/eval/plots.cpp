@@ -21,14 +21,6 @@ const cv::Scalar kBlue(180, 119, 31), kOrange(14, 127, 255), kGreen(44, 160, 44)
 
 constexpr std::array<const char*, 3> kAxisNames = {"x", "y", "z"};
 
-// Encoded in memory and written whole or not at all, like every other output.
-void save(const cv::Mat& img, const std::filesystem::path& path) {
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", img, png)) throw InputError(path.string(), "cannot encode the plot");
-  io::write_file_atomically(path, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-  });
-}
 
 void add_statistic_lines(Chart& c, const ErrorStatistics& s, const char* unit) {
   c.add_hline(s.rmse, {kRed, 2, false}, fmt::format("rmse {:.4g} {}", s.rmse, unit));
@@ -52,6 +44,14 @@ std::string alignment_text(const EvalResult& r) {
 }
 
 }  // namespace
+
+void save_png(const cv::Mat& img, const std::filesystem::path& path) {
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", img, png)) throw InputError(path.string(), "cannot encode the plot");
+  io::write_file_atomically(path, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  });
+}
 
 std::pair<int, int> top_view_axes(const Trajectory& gt) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
@@ -92,7 +92,7 @@ std::vector<std::filesystem::path> write_plots(const EvalResult& r, const std::f
     cv::Mat img(900, 900, CV_8UC3);
     c.draw(img);
     written.push_back(dir / "trajectory.png");
-    save(img, written.back());
+    save_png(img, written.back());
   }
 
   {  // APE over time.
@@ -110,7 +110,7 @@ std::vector<std::filesystem::path> write_plots(const EvalResult& r, const std::f
     cv::Mat img(450, 1100, CV_8UC3);
     c.draw(img);
     written.push_back(dir / "ape.png");
-    save(img, written.back());
+    save_png(img, written.back());
   }
 
   {  // RPE over time: translation above, rotation below, at the end pose of each pair.
@@ -144,7 +144,7 @@ std::vector<std::filesystem::path> write_plots(const EvalResult& r, const std::f
     cv::Mat lower = img(cv::Rect(0, img.rows / 2, img.cols, img.rows - img.rows / 2));
     cr.draw(lower);
     written.push_back(dir / "rpe.png");
-    save(img, written.back());
+    save_png(img, written.back());
   }
   return written;
 }
@@ -215,7 +215,7 @@ std::filesystem::path write_tracking_plot(const EvalResult& r, const FrameLog& l
   loc.draw(p3);
 
   const auto path = dir / "tracking.png";
-  save(img, path);
+  save_png(img, path);
   return path;
 }
 

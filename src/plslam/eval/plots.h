@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "plslam/eval/evaluate.h"
 #include "plslam/eval/frame_log.h"
 
@@ -11,6 +13,9 @@ namespace plslam::eval {
 struct PlotOptions {
   bool x_is_frame = false;  // the poses carry frame indices, not seconds (KITTI files)
 };
+
+// Encodes `img` as PNG and writes it whole or not at all (InputError naming `path`).
+void save_png(const cv::Mat& img, const std::filesystem::path& path);
 
 // The two axes of the top view: the ones along which the ground truth extends most (the dropped
 // axis is the vertical one: z for EuRoC/TUM worlds, y for KITTI camera frames).

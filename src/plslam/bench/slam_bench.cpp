@@ -1,0 +1,324 @@
+#include "plslam/bench/slam_bench.h"
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "plslam/core/error.h"
+#include "plslam/core/sample_stats.h"
+#include "plslam/eval/evaluate.h"
+#include "plslam/io/trajectory_io.h"
+
+namespace plslam::bench {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::vector<BenchRow> bench_rows(const std::vector<SlamConfiguration>& configs, const std::string& anchor_name) {
+  std::vector<BenchRow> rows;
+  bool odometry = false;
+  for (const auto& c : configs) {
+    rows.push_back({c.name, false, true, c});
+    odometry = odometry || c.name == "no-loop-closing";
+  }
+  if (!anchor_name.empty()) {
+    rows.push_back({anchor_name, true, true, {}});
+    if (odometry) rows.push_back({anchor_name + "-no-loop-closing", true, false, {}});
+  }
+  return rows;
+}
+
+std::vector<BenchJob> plan_jobs(std::size_t datasets, std::size_t rows, int runs) {
+  std::vector<BenchJob> jobs;
+  for (int r = 1; r <= runs; ++r) {
+    for (std::size_t d = 0; d < datasets; ++d) {
+      for (std::size_t k = 0; k < rows; ++k) jobs.push_back({d, k, r});
+    }
+  }
+  return jobs;
+}
+
+std::vector<BenchDataset> name_datasets(const std::vector<fs::path>& paths) {
+  std::vector<BenchDataset> out;
+  std::set<std::string> used;
+  for (const auto& p : paths) {
+    fs::path clean = p.lexically_normal();
+    if (clean.filename().empty()) clean = clean.parent_path();
+    std::string name = clean.filename().string();
+    if (name == "mav0") name = clean.parent_path().filename().string();
+    if (!name.empty() && std::all_of(name.begin(), name.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+      name = "kitti-" + name;
+    }
+    if (name.empty() || name == "." || name == "..") name = "dataset";
+    std::string unique = name;
+    for (int i = 2; used.count(unique); ++i) unique = fmt::format("{}-{}", name, i);
+    used.insert(unique);
+    out.push_back({unique, p});
+  }
+  return out;
+}
+
+fs::path run_folder(const fs::path& out, const BenchDataset& d, const BenchRow& r, int run) {
+  return out / "runs" / d.name / r.name / fmt::format("run-{}", run);
+}
+
+const std::vector<MetricInfo>& bench_metrics() {
+  static const std::vector<MetricInfo> metrics = {
+      {"ate_m", "ATE m", 4},
+      {"rpe_frame_trans_m", "RPE 1 frame m", 4},
+      {"rpe_frame_rot_deg", "RPE 1 frame deg", 3},
+      {"rpe_1m_trans_m", "RPE 1 m m", 4},
+      {"rpe_1m_rot_deg", "RPE 1 m deg", 3},
+      {"tracked_share", "tracked", 3},
+      {"lost_events", "lost", 0},
+      {"relocalizations", "reloc", 0},
+      {"loops", "loops", 0},
+      {"keyframes", "KF", 0},
+      {"map_points", "points", 0},
+      {"map_lines", "lines", 0},
+      {"tracking_ms_median", "track ms", 1},
+      {"tracking_ms_p90", "track ms p90", 1},
+  };
+  return metrics;
+}
+
+namespace {
+
+json read_json(const fs::path& p) {
+  std::ifstream in(p);
+  if (!in) throw InputError(p.string(), "missing");
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(p.string(), std::string("not JSON: ") + e.what());
+  }
+}
+
+json number_at(const json& j, std::initializer_list<const char*> path) {
+  const json* cur = &j;
+  for (const char* key : path) {
+    if (!cur->is_object() || !cur->contains(key)) return nullptr;
+    cur = &(*cur)[key];
+  }
+  return cur->is_number() ? *cur : json(nullptr);
+}
+
+double ratio(const json& a, const json& b) {
+  if (!a.is_number() || !b.is_number() || b.get<double>() <= 0) return 0.0;
+  return a.get<double>() / b.get<double>();
+}
+
+}  // namespace
+
+json measure_run(const io::Dataset& dataset, const fs::path& folder, bool anchor) {
+  json m = json::object();
+  for (const auto& k : bench_metrics()) m[k.key] = nullptr;
+  json stats;
+  try {
+    stats = read_json(folder / "stats.json");
+  } catch (const InputError& e) {
+    m["error"] = e.what();
+    return m;
+  }
+  if (anchor) {
+    const json frames = number_at(stats, {"frames"}), ok = number_at(stats, {"frames_tracked_ok"});
+    if (frames.is_number() && ok.is_number() && frames.get<double>() > 0) m["tracked_share"] = ratio(ok, frames);
+    m["lost_events"] = number_at(stats, {"events", "lost_transitions"});
+    m["relocalizations"] = number_at(stats, {"events", "relocalized"});
+    m["loops"] = number_at(stats, {"loop_corrections"});
+  } else {
+    const json frames = number_at(stats, {"input_frames"}), ok = number_at(stats, {"tracked_frames"});
+    if (frames.is_number() && ok.is_number() && frames.get<double>() > 0) m["tracked_share"] = ratio(ok, frames);
+    m["lost_events"] = number_at(stats, {"lost_events"});
+    m["relocalizations"] = number_at(stats, {"relocalizations", "count"});
+    m["loops"] = stats.contains("loops") && stats["loops"].is_array() ? json(stats["loops"].size()) : json(nullptr);
+    m["map_lines"] = number_at(stats, {"map_lines"});
+  }
+  m["keyframes"] = number_at(stats, {"keyframes"});
+  m["map_points"] = number_at(stats, {"map_points"});
+  m["tracking_ms_median"] = number_at(stats, {"tracking_ms", "median"});
+  m["tracking_ms_p90"] = number_at(stats, {"tracking_ms", "p90"});
+
+  const fs::path traj = folder / "trajectory.tum";
+  if (!dataset.ground_truth()) {
+    m["error"] = "the dataset has no ground truth";
+    return m;
+  }
+  if (!fs::exists(traj)) {
+    m["error"] = traj.string() + ": missing (the run wrote no trajectory)";
+    return m;
+  }
+  try {
+    const auto est = io::read_trajectory(traj, io::TrajectoryFormat::kTum);
+    eval::EvalOptions o;
+    o.align = eval::AlignMode::kSE3;
+    const auto r = eval::evaluate(*dataset.ground_truth(), est, o);
+    m["ate_m"] = r.ape_trans_stats.rmse;
+    m["rpe_frame_trans_m"] = r.rpe_trans_stats.rmse;
+    m["rpe_frame_rot_deg"] = r.rpe_rot_stats.rmse;
+    m["coverage"] = r.coverage;
+    try {
+      eval::EvalOptions om = o;
+      om.rpe.delta = 1.0;
+      om.rpe.unit = eval::DeltaUnit::kMeters;
+      const auto rm = eval::evaluate(*dataset.ground_truth(), est, om);
+      m["rpe_1m_trans_m"] = rm.rpe_trans_stats.rmse;
+      m["rpe_1m_rot_deg"] = rm.rpe_rot_stats.rmse;
+    } catch (const InputError&) {
+      // A path shorter than 1 m has no 1 m pair: the metric stays null.
+    }
+  } catch (const InputError& e) {
+    m["error"] = e.what();
+  }
+  return m;
+}
+
+json summarize_runs(const json& results, const std::vector<BenchDataset>& datasets, const std::vector<BenchRow>& rows) {
+  json summary = json::object();
+  for (const auto& d : datasets) {
+    json per_row = json::object();
+    for (const auto& row : rows) {
+      json s = json::object();
+      int failed = 0, done = 0;
+      for (const auto& k : bench_metrics()) {
+        std::vector<double> v;
+        for (const auto& r : results) {
+          if (r["dataset"] != d.name || r["row"] != row.name) continue;
+          if (r["exit_code"] != 0) continue;
+          const auto& x = r["metrics"][k.key];
+          if (x.is_number()) v.push_back(x.get<double>());
+        }
+        if (v.empty()) {
+          s[k.key] = nullptr;
+          continue;
+        }
+        std::sort(v.begin(), v.end());
+        s[k.key] = {{"median", percentile(v, 0.5)}, {"min", v.front()}, {"max", v.back()}, {"n", v.size()}};
+      }
+      for (const auto& r : results) {
+        if (r["dataset"] != d.name || r["row"] != row.name) continue;
+        ++done;
+        if (r["exit_code"] != 0) ++failed;
+      }
+      s["runs"] = done;
+      s["failed_runs"] = failed;
+      per_row[row.name] = s;
+    }
+    auto median_of = [&](const std::string& row, const char* key) -> json {
+      if (!per_row.contains(row) || !per_row[row][key].is_object()) return nullptr;
+      return per_row[row][key]["median"];
+    };
+    for (const auto& row : rows) {
+      json& s = per_row[row.name];
+      if (!row.anchor && row.name != "full" && per_row.contains("full")) {
+        s["ratio_to_full"] = {{"ate_m", ratio(median_of(row.name, "ate_m"), median_of("full", "ate_m"))},
+                              {"tracking_ms_median", ratio(median_of(row.name, "tracking_ms_median"),
+                                                           median_of("full", "tracking_ms_median"))}};
+      }
+      if (!row.anchor) {
+        // Against the anchor with the same loop-closing setting.
+        const bool odometry = row.config.yaml.find("loop: {enabled: false}") != std::string::npos;
+        for (const auto& a : rows) {
+          if (!a.anchor || a.anchor_loop_closing == odometry) continue;
+          s["ratio_to_anchor"] = {{"anchor", a.name},
+                                  {"ate_m", ratio(median_of(row.name, "ate_m"), median_of(a.name, "ate_m"))},
+                                  {"tracking_ms_median", ratio(median_of(row.name, "tracking_ms_median"),
+                                                               median_of(a.name, "tracking_ms_median"))}};
+        }
+      }
+    }
+    summary[d.name] = per_row;
+  }
+  return summary;
+}
+
+namespace {
+
+std::string cell(const json& s, const MetricInfo& k) {
+  if (!s.is_object() || !s.contains(k.key) || !s[k.key].is_object()) return "–";
+  const auto& v = s[k.key];
+  const double med = v["median"].get<double>(), lo = v["min"].get<double>(), hi = v["max"].get<double>();
+  const bool share = std::string(k.key) == "tracked_share";
+  const double f = share ? 100.0 : 1.0;
+  const int dec = share ? 1 : k.decimals;
+  if (v["n"].get<int>() == 1 || lo == hi) return fmt::format("{:.{}f}", med * f, dec);
+  return fmt::format("{:.{}f} ({:.{}f}–{:.{}f})", med * f, dec, lo * f, dec, hi * f, dec);
+}
+
+std::string ratio_cell(const json& s, const char* which, const char* key) {
+  if (!s.contains(which) || !s[which][key].is_number() || s[which][key].get<double>() <= 0) return "–";
+  return fmt::format("{:.2f}", s[which][key].get<double>());
+}
+
+}  // namespace
+
+std::string format_report_markdown(const json& report) {
+  std::string md = "# plslam bench slam\n\n";
+  md += fmt::format("`{}`\n\n", report.value("command", std::string("plslam bench slam")));
+  md += fmt::format("{} · plslam {} · {} runs per row, {} mode · {} hardware threads · wall {:.0f} s{}\n\n",
+                    report.value("date", std::string("")), report.value("version", std::string("")),
+                    report.value("runs", 0), report.value("mode", std::string("")), report.value("hardware_threads", 0),
+                    report.value("wall_s", 0.0),
+                    report["interrupted_by"].is_string()
+                        ? " · **interrupted by " + report["interrupted_by"].get<std::string>() + "**: partial"
+                        : std::string());
+  md += "Cells: median (min–max) over the runs. ATE: SE(3)-aligned RMSE of the translation; RPE with evo's "
+        "definitions (consecutive pairs 1 frame or 1 m of path apart). Ratios are of medians.\n\n";
+  md += "Configurations:\n\n";
+  for (const auto& c : report["configurations"]) {
+    md += fmt::format("- `{}`: {}\n", c["name"].get<std::string>(), c["description"].get<std::string>());
+  }
+  md += "\n";
+  const auto& metrics = bench_metrics();
+  for (const auto& d : report["datasets"]) {
+    const std::string name = d["name"].get<std::string>();
+    md += fmt::format("## {}\n\n`{}`, {} frames{}\n\n", name, d["path"].get<std::string>(), d.value("frames", 0),
+                      d["gt_length_m"].is_number() ? fmt::format(", ground truth {:.1f} m", d["gt_length_m"].get<double>())
+                                                   : std::string());
+    const json& per_row = report["summary"][name];
+    md += "| configuration | ATE m | RPE 1 frame m | RPE 1 frame deg | RPE 1 m m | RPE 1 m deg | ATE / full | ATE / anchor |\n";
+    md += "|---|---|---|---|---|---|---|---|\n";
+    for (const auto& row : report["rows"]) {
+      const std::string r = row["name"].get<std::string>();
+      const json& s = per_row[r];
+      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", r, cell(s, metrics[0]), cell(s, metrics[1]),
+                        cell(s, metrics[2]), cell(s, metrics[3]), cell(s, metrics[4]), ratio_cell(s, "ratio_to_full", "ate_m"),
+                        ratio_cell(s, "ratio_to_anchor", "ate_m"));
+    }
+    md += "\n| configuration | tracked % | lost | reloc | loops | KF | points | lines | track ms | track ms p90 | ms / full | ms / anchor | failed runs |\n";
+    md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& row : report["rows"]) {
+      const std::string r = row["name"].get<std::string>();
+      const json& s = per_row[r];
+      md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} |\n", r, cell(s, metrics[5]),
+                        cell(s, metrics[6]), cell(s, metrics[7]), cell(s, metrics[8]), cell(s, metrics[9]),
+                        cell(s, metrics[10]), cell(s, metrics[11]), cell(s, metrics[12]), cell(s, metrics[13]),
+                        ratio_cell(s, "ratio_to_full", "tracking_ms_median"),
+                        ratio_cell(s, "ratio_to_anchor", "tracking_ms_median"), s.value("failed_runs", 0),
+                        s.value("runs", 0));
+    }
+    md += "\n";
+    if (report.contains("figures") && report["figures"].contains(name)) {
+      for (const auto& f : report["figures"][name]) md += fmt::format("![{0}]({0})\n", f.get<std::string>());
+      md += "\n";
+    }
+  }
+  if (report.contains("table1") && !report["table1"].empty()) {
+    md += "## Table I: keypoint distribution (one thread, left image, same FAST candidates)\n\n";
+    md += "| dataset | frames | SSC ms | quadtree ms | SSC speed-up |\n|---|---|---|---|---|\n";
+    for (const auto& [name, t] : report["table1"].items()) {
+      md += fmt::format("| {} | {} | {:.3f} | {:.3f} | {:.1f}x |\n", name, t.value("frames", 0), t.value("ssc_ms", 0.0),
+                        t.value("quadtree_ms", 0.0), t.value("ssc_speedup", 0.0));
+    }
+    md += "\n";
+  }
+  if (report.contains("figures") && report["figures"].contains("all")) {
+    for (const auto& f : report["figures"]["all"]) md += fmt::format("![{0}]({0})\n", f.get<std::string>());
+    md += "\n";
+  }
+  return md;
+}
+
+}  // namespace plslam::bench
