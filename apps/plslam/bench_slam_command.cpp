@@ -180,17 +180,19 @@ int run_bench_slam(const BenchSlamArgs& a) {
 
   // Datasets: the preset's (rendered ones first), then the user's.
   std::vector<fs::path> paths;
+  std::vector<std::string> names;  // the rendered sequences are named by the preset
   for (const auto& r : preset_renders(a.preset)) {
     auto p = render(out, r);
     if (app::stop_requested()) return app::stop_exit_code();
     paths.push_back(p);
+    names.push_back(r.name);
   }
   if (a.preset == "paper") {
     for (auto& p : paper_real_sequences(a.shared)) paths.push_back(p);
   }
   for (const auto& d : a.datasets) paths.emplace_back(d);
   if (paths.empty()) throw InputError("", "no dataset: give sequences or --preset quick|paper");
-  const auto datasets = bench::name_datasets(paths);
+  const auto datasets = bench::name_datasets(paths, names);
   std::vector<std::unique_ptr<io::Dataset>> opened;
   for (const auto& d : datasets) {
     opened.push_back(io::open_dataset(d.path));

@@ -36,38 +36,29 @@ double eval_ate(const fs::path& dataset, const fs::path& est) {
   return json::parse(r.out)["ape_trans_m"]["rmse"].get<double>();
 }
 
-// One quick-preset bench for the whole suite: rendering and 6 runs take a while under ASan.
-class BenchSlamCli : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    dir_ = new test::TempDir;
-    const auto r = run_cli("bench slam --preset quick --runs 1 --sequential --table1-frames 3 --json --out " +
-                           q(dir_->path() / "seq"));
-    exit_code_ = r.exit_code;
-    err_ = r.err;
-    if (r.exit_code == 0) report_ = json::parse(r.out);  // stdout is only the JSON
-  }
-  static void TearDownTestSuite() {
-    delete dir_;
-    dir_ = nullptr;
-  }
-  static fs::path seq() { return dir_->path() / "seq"; }
-  static fs::path dataset() { return seq() / "data" / "office-quick"; }
+// A short rendered office sequence of its own for each test (ctest runs every test in a process).
+fs::path render_office(const fs::path& dir, int frames) {
+  const auto out = dir / "office";
+  const auto r = run_cli("synth --scene office --preset euroc --frames " + std::to_string(frames) +
+                         " --seed 11 --out " + q(out));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return out;
+}
 
-  static inline test::TempDir* dir_ = nullptr;
-  static inline int exit_code_ = -1;
-  static inline std::string err_;
-  static inline json report_;
-};
-
-TEST_F(BenchSlamCli, QuickPresetReportsEveryConfigurationAndMetric) {
-  ASSERT_EQ(exit_code_, 0) << err_;
-  EXPECT_EQ(read_json(seq() / "report.json"), report_);
+// The quick preset, sequential: every configuration and metric is in the report, and each
+// number equals that of a separate `plslam run --sequential` + `plslam eval`.
+TEST(BenchSlamCli, QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequentialRunsDo) {
+  test::TempDir dir;
+  const auto seq = dir.path() / "seq";
+  const auto r = run_cli("bench slam --preset quick --runs 1 --sequential --table1-frames 3 --json --out " + q(seq));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json report = json::parse(r.out);  // stdout is only the JSON
+  EXPECT_EQ(read_json(seq / "report.json"), report);
   std::vector<std::string> names;
-  for (const auto& c : report_["configurations"]) names.push_back(c["name"]);
+  for (const auto& c : report["configurations"]) names.push_back(c["name"]);
   EXPECT_EQ(names, (std::vector<std::string>{"full", "no-lines", "quadtree", "no-pid", "no-kalman", "no-loop-closing"}));
-  ASSERT_EQ(report_["datasets"].size(), 1u);
-  const json& s = report_["summary"]["office-quick"];
+  ASSERT_EQ(report["datasets"].size(), 1u);
+  const json& s = report["summary"]["office-quick"];
   for (const auto& name : names) {
     for (const auto& k : bench_metrics()) {
       if (name == "no-lines" && std::string(k.key) == "map_lines") continue;  // 0 lines: still a number
@@ -82,41 +73,40 @@ TEST_F(BenchSlamCli, QuickPresetReportsEveryConfigurationAndMetric) {
   EXPECT_LT(s["full"]["ate_m"]["median"].get<double>(), 0.02);
   EXPECT_TRUE(s["no-lines"]["ratio_to_full"]["ate_m"].is_number());
   // Table I and the figures exist and are named in the report.
-  const json& t1 = report_["table1"]["office-quick"];
+  const json& t1 = report["table1"]["office-quick"];
   EXPECT_GT(t1["quadtree_ms"].get<double>(), 0.0);
   EXPECT_GT(t1["ssc_speedup"].get<double>(), 0.0);
   int figures = 0;
-  for (const auto& [key, list] : report_["figures"].items()) {
+  for (const auto& [key, list] : report["figures"].items()) {
     for (const auto& f : list) {
-      EXPECT_TRUE(fs::exists(seq() / f.get<std::string>())) << f;
+      EXPECT_TRUE(fs::exists(seq / f.get<std::string>())) << f;
       ++figures;
     }
   }
   EXPECT_EQ(figures, 6);
-  const auto md = test::read_file(seq() / "report.md");
+  const auto md = test::read_file(seq / "report.md");
   for (const auto& name : names) EXPECT_NE(md.find("| " + name + " |"), std::string::npos) << name;
   EXPECT_NE(md.find("Table I"), std::string::npos);
-}
 
-TEST_F(BenchSlamCli, SequentialRunsEqualASeparateRunAndEvalExactly) {
-  ASSERT_EQ(exit_code_, 0) << err_;
+  const auto dataset = seq / "data" / "office-quick";
   for (const std::string config : {"full", "no-lines"}) {
-    const auto out = dir_->path() / ("separate-" + config);
-    const auto r = run_cli("run " + q(dataset()) + " --sequential --quiet --config " +
-                           q(seq() / "configs" / (config + ".yaml")) + " --out " + q(out));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto out = dir.path() / ("separate-" + config);
+    const auto rr = run_cli("run " + q(dataset) + " --sequential --quiet --config " +
+                            q(seq / "configs" / (config + ".yaml")) + " --out " + q(out));
+    ASSERT_EQ(rr.exit_code, 0) << rr.err;
     EXPECT_EQ(test::read_file(out / "trajectory.tum"),
-              test::read_file(seq() / "runs" / "office-quick" / config / "run-1" / "trajectory.tum"))
+              test::read_file(seq / "runs" / "office-quick" / config / "run-1" / "trajectory.tum"))
         << config;
-    const double ate = eval_ate(dataset(), out / "trajectory.tum");
-    EXPECT_EQ(report_["summary"]["office-quick"][config]["ate_m"]["median"].get<double>(), ate) << config;
+    const double ate = eval_ate(dataset, out / "trajectory.tum");
+    EXPECT_EQ(report["summary"]["office-quick"][config]["ate_m"]["median"].get<double>(), ate) << config;
   }
 }
 
-TEST_F(BenchSlamCli, ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAnchorIsARow) {
-  ASSERT_EQ(exit_code_, 0) << err_;
+TEST(BenchSlamCli, ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAnchorIsARow) {
+  test::TempDir dir;
+  const auto dataset = render_office(dir.path(), 40);
   // A stand-in anchor with the runner's interface: the ground truth with a 1 cm wobble.
-  const auto anchor = dir_->path() / "anchor.sh";
+  const auto anchor = dir.path() / "anchor.sh";
   std::ofstream(anchor) << "#!/bin/sh\n"
                            "set -e\n"
                            "ds=$1; out=$3; mkdir -p \"$out\"\n"
@@ -127,12 +117,12 @@ TEST_F(BenchSlamCli, ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAn
                            "\\\"map_points\\\": 100, \\\"loop_corrections\\\": 0, \\\"events\\\": {\\\"lost_transitions\\\": 0, "
                            "\\\"relocalized\\\": 0}, \\\"tracking_ms\\\": {\\\"median\\\": 30, \\\"p90\\\": 40}}\" > \"$out/stats.json\"\n";
   ::chmod(anchor.c_str(), 0755);
-  const auto out = dir_->path() / "conc";
-  const auto r = run_cli("bench slam " + q(dataset()) + " --configs full --runs 3 --table1-frames 0 --anchor " + q(anchor) +
+  const auto out = dir.path() / "conc";
+  const auto r = run_cli("bench slam " + q(dataset) + " --configs full --runs 3 --table1-frames 0 --anchor " + q(anchor) +
                          " --out " + q(out));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json rep = read_json(out / "report.json");
-  const json& s = rep["summary"]["office-quick"];
+  const json& s = rep["summary"]["office"];
   ASSERT_TRUE(s["anchor"]["ate_m"].is_object()) << s.dump();
   EXPECT_NEAR(s["anchor"]["ate_m"]["median"].get<double>(), 0.005, 0.002);
   EXPECT_EQ(s["anchor"]["keyframes"]["median"], 7);
@@ -141,10 +131,10 @@ TEST_F(BenchSlamCli, ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAn
   const double lo = s["full"]["ate_m"]["min"].get<double>(), hi = s["full"]["ate_m"]["max"].get<double>();
   const double med = s["full"]["ate_m"]["median"].get<double>();
 
-  const auto sep = dir_->path() / "separate-concurrent";
-  const auto rr = run_cli("run " + q(dataset()) + " --quiet --out " + q(sep));
+  const auto sep = dir.path() / "separate-concurrent";
+  const auto rr = run_cli("run " + q(dataset) + " --quiet --out " + q(sep));
   ASSERT_EQ(rr.exit_code, 0) << rr.err;
-  const double ate = eval_ate(dataset(), sep / "trajectory.tum");
+  const double ate = eval_ate(dataset, sep / "trajectory.tum");
   // Within the bench's spread, widened by the larger of 3 spreads and half the median (three runs
   // under-sample the spread of concurrent runs, and sanitizer builds shift the thread timing).
   const double slack = std::max(3.0 * (hi - lo), 0.5 * med);
@@ -152,10 +142,11 @@ TEST_F(BenchSlamCli, ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAn
   EXPECT_LE(ate, hi + slack) << "bench " << lo << "-" << hi << ", separate " << ate;
 }
 
-TEST_F(BenchSlamCli, SigtermStopsAtARunBoundaryAndTheReportCoversTheRunsDone) {
-  ASSERT_EQ(exit_code_, 0) << err_;
-  const auto out = dir_->path() / "stopped";
-  const auto r = run_cli("bench slam " + q(dataset()) + " --runs 5 --table1-frames 0 --out " + q(out) +
+TEST(BenchSlamCli, SigtermStopsAtARunBoundaryAndTheReportCoversTheRunsDone) {
+  test::TempDir dir;
+  const auto dataset = render_office(dir.path(), 40);
+  const auto out = dir.path() / "stopped";
+  const auto r = run_cli("bench slam " + q(dataset) + " --runs 5 --table1-frames 0 --out " + q(out) +
                          " & pid=$!; sleep 4; kill -TERM $pid; wait $pid");
   EXPECT_EQ(r.exit_code, 143) << r.err;
   ASSERT_TRUE(fs::exists(out / "report.json")) << r.err;

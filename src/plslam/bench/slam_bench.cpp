@@ -40,10 +40,11 @@ std::vector<BenchJob> plan_jobs(std::size_t datasets, std::size_t rows, int runs
   return jobs;
 }
 
-std::vector<BenchDataset> name_datasets(const std::vector<fs::path>& paths) {
+std::vector<BenchDataset> name_datasets(const std::vector<fs::path>& paths, const std::vector<std::string>& preferred) {
   std::vector<BenchDataset> out;
   std::set<std::string> used;
-  for (const auto& p : paths) {
+  for (std::size_t k = 0; k < paths.size(); ++k) {
+    const fs::path& p = paths[k];
     fs::path clean = p.lexically_normal();
     if (clean.filename().empty()) clean = clean.parent_path();
     std::string name = clean.filename().string();
@@ -52,6 +53,7 @@ std::vector<BenchDataset> name_datasets(const std::vector<fs::path>& paths) {
       name = "kitti-" + name;
     }
     if (name.empty() || name == "." || name == "..") name = "dataset";
+    if (k < preferred.size() && !preferred[k].empty()) name = preferred[k];
     std::string unique = name;
     for (int i = 2; used.count(unique); ++i) unique = fmt::format("{}-{}", name, i);
     used.insert(unique);
@@ -249,7 +251,7 @@ std::string cell(const json& s, const MetricInfo& k) {
 
 std::string ratio_cell(const json& s, const char* which, const char* key) {
   if (!s.contains(which) || !s[which][key].is_number() || s[which][key].get<double>() <= 0) return "–";
-  return fmt::format("{:.2f}", s[which][key].get<double>());
+  return fmt::format("{:.3g}", s[which][key].get<double>());
 }
 
 }  // namespace
@@ -275,7 +277,7 @@ std::string format_report_markdown(const json& report) {
   for (const auto& d : report["datasets"]) {
     const std::string name = d["name"].get<std::string>();
     md += fmt::format("## {}\n\n`{}`, {} frames{}\n\n", name, d["path"].get<std::string>(), d.value("frames", 0),
-                      d["gt_length_m"].is_number() ? fmt::format(", ground truth {:.1f} m", d["gt_length_m"].get<double>())
+                      d["gt_length_m"].is_number() ? fmt::format(", ground truth {:.2f} m", d["gt_length_m"].get<double>())
                                                    : std::string());
     const json& per_row = report["summary"][name];
     md += "| configuration | ATE m | RPE 1 frame m | RPE 1 frame deg | RPE 1 m m | RPE 1 m deg | ATE / full | ATE / anchor |\n";
@@ -308,7 +310,10 @@ std::string format_report_markdown(const json& report) {
   if (report.contains("table1") && !report["table1"].empty()) {
     md += "## Table I: keypoint distribution (one thread, left image, same FAST candidates)\n\n";
     md += "| dataset | frames | SSC ms | quadtree ms | SSC speed-up |\n|---|---|---|---|---|\n";
-    for (const auto& [name, t] : report["table1"].items()) {
+    for (const auto& d : report["datasets"]) {
+      const std::string name = d["name"].get<std::string>();
+      if (!report["table1"].contains(name)) continue;
+      const json& t = report["table1"][name];
       md += fmt::format("| {} | {} | {:.3f} | {:.3f} | {:.1f}x |\n", name, t.value("frames", 0), t.value("ssc_ms", 0.0),
                         t.value("quadtree_ms", 0.0), t.value("ssc_speedup", 0.0));
     }

@@ -43,9 +43,10 @@ std::vector<BenchRow> bench_rows(const std::vector<SlamConfiguration>& configs, 
 // Run 1 of every dataset and row, then run 2, ...: the rows alternate run by run.
 std::vector<BenchJob> plan_jobs(std::size_t datasets, std::size_t rows, int runs);
 
-// Unique names for dataset folders: the folder's name, "kitti-06" for a KITTI sequences/06, a
-// numeric suffix on a clash.
-std::vector<BenchDataset> name_datasets(const std::vector<std::filesystem::path>& paths);
+// Unique names for dataset folders: preferred[i] when given and not empty, else the folder's
+// name ("kitti-06" for a KITTI sequences/06); a numeric suffix on a clash.
+std::vector<BenchDataset> name_datasets(const std::vector<std::filesystem::path>& paths,
+                                        const std::vector<std::string>& preferred = {});
 
 // The folder of one run: OUT/runs/<dataset>/<row>/run-<n>.
 std::filesystem::path run_folder(const std::filesystem::path& out, const BenchDataset& d, const BenchRow& r, int run);

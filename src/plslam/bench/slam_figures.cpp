@@ -1,8 +1,10 @@
 #include "plslam/bench/slam_figures.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -53,15 +55,16 @@ double time_of(const Trajectory& t, std::size_t i, bool x_is_frame) {
   return x_is_frame ? static_cast<double>(i) : t[i].t - t.front().t;
 }
 
-void top_view(const std::string& title, const Trajectory& gt, const std::vector<std::pair<std::string, Trajectory>>& est,
-              const fs::path& path) {
-  const auto [a, b] = eval::top_view_axes(gt);
-  const char* names = "xyz";
-  auto f = [a = a, b = b](const Eigen::Vector3d& p) { return cv::Point2d(p[a], p[b]); };
+using Projection = std::function<cv::Point2d(const Eigen::Vector3d&)>;
+using NamedTrajectories = std::vector<std::pair<std::string, Trajectory>>;
+
+// The ground truth (dashed black) and each row's trajectory, one metre as long on both axes.
+void draw_trajectories(const std::string& title, const std::string& xlabel, const std::string& ylabel,
+                       const Trajectory& gt, const NamedTrajectories& est, const Projection& f, const fs::path& path) {
   eval::Chart c;
   c.set_title(title);
-  c.set_xlabel(fmt::format("{} [m]", names[a]));
-  c.set_ylabel(fmt::format("{} [m]", names[b]));
+  c.set_xlabel(xlabel);
+  c.set_ylabel(ylabel);
   c.set_equal_aspect(true);
   c.add_line(project(gt, f), {kBlack, 2, true}, "ground truth");
   for (std::size_t i = 0; i < est.size(); ++i) c.add_line(project(est[i].second, f), {colour(i), 2, false}, est[i].first);
@@ -70,9 +73,15 @@ void top_view(const std::string& title, const Trajectory& gt, const std::vector<
   eval::save_png(img, path);
 }
 
+void top_view(const std::string& title, const Trajectory& gt, const NamedTrajectories& est, const fs::path& path) {
+  const auto [a, b] = eval::top_view_axes(gt);
+  const char* names = "xyz";
+  draw_trajectories(title, fmt::format("{} [m]", names[a]), fmt::format("{} [m]", names[b]), gt, est,
+                    [a = a, b = b](const Eigen::Vector3d& p) { return cv::Point2d(p[a], p[b]); }, path);
+}
+
 // An oblique parallel projection: azimuth 35 deg about the vertical axis, elevation 25 deg.
-void view_3d(const std::string& title, const Trajectory& gt, const std::vector<std::pair<std::string, Trajectory>>& est,
-             const fs::path& path) {
+void view_3d(const std::string& title, const Trajectory& gt, const NamedTrajectories& est, const fs::path& path) {
   const auto [a, b] = eval::top_view_axes(gt);
   const int up = 3 - a - b;
   const double az = 35.0 * M_PI / 180, el = 25.0 * M_PI / 180;
@@ -82,16 +91,7 @@ void view_3d(const std::string& title, const Trajectory& gt, const std::vector<s
     const double y = std::cos(el) * p[up] + std::sin(el) * depth;
     return cv::Point2d(x, y);
   };
-  eval::Chart c;
-  c.set_title(title);
-  c.set_xlabel("oblique view, horizontal [m]");
-  c.set_ylabel("oblique view, vertical [m]");
-  c.set_equal_aspect(true);
-  c.add_line(project(gt, f), {kBlack, 2, true}, "ground truth");
-  for (std::size_t i = 0; i < est.size(); ++i) c.add_line(project(est[i].second, f), {colour(i), 2, false}, est[i].first);
-  cv::Mat img(900, 1000, CV_8UC3, cv::Scalar(255, 255, 255));
-  c.draw(img);
-  eval::save_png(img, path);
+  draw_trajectories(title, "oblique view, horizontal [m]", "oblique view, vertical [m]", gt, est, f, path);
 }
 
 }  // namespace
@@ -129,7 +129,7 @@ std::vector<double> read_frame_times(const fs::path& folder) {
 std::vector<std::string> write_dataset_figures(const fs::path& dir, const std::string& dataset, const Trajectory& gt,
                                                const std::vector<FigureRun>& runs, bool x_is_frame) {
   std::vector<std::string> written;
-  std::vector<std::pair<std::string, Trajectory>> aligned, first_pose;
+  NamedTrajectories aligned, first_pose;
   for (const auto& r : runs) {
     aligned.emplace_back(r.row, r.result.est);
     first_pose.emplace_back(r.row, at_first_pose(r, gt));
@@ -146,8 +146,20 @@ std::vector<std::string> write_dataset_figures(const fs::path& dir, const std::s
   written.push_back(name("trajectory_3d"));
 
   {  // translation and rotation error over time, two panels
+    // A row that failed (ATE over 5x the median row's) would flatten every other curve: it is
+    // left out here and named in the title; the trajectory figures show it.
+    std::vector<double> ates;
+    for (const auto& r : runs) ates.push_back(r.result.ape_trans_stats.rmse);
+    std::vector<double> sorted = ates;
+    std::sort(sorted.begin(), sorted.end());
+    const double median_ate = sorted[(sorted.size() - 1) / 2];
+    std::string left_out;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      if (ates[i] > 5 * median_ate) left_out += (left_out.empty() ? "" : ", ") + runs[i].row;
+    }
+    const std::string note = left_out.empty() ? "" : " (not drawn, ATE > 5x the median row's: " + left_out + ")";
     eval::Chart ct, cr;
-    ct.set_title(dataset + ": translation error over time (SE(3)-aligned)");
+    ct.set_title(dataset + ": translation error over time (SE(3)-aligned)" + note);
     ct.set_xlabel(x_label);
     ct.set_ylabel("APE [m]");
     ct.set_y_from_zero(true);
@@ -156,6 +168,7 @@ std::vector<std::string> write_dataset_figures(const fs::path& dir, const std::s
     cr.set_ylabel("rotation error [deg]");
     cr.set_y_from_zero(true);
     for (std::size_t i = 0; i < runs.size(); ++i) {
+      if (ates[i] > 5 * median_ate) continue;
       const auto& r = runs[i].result;
       std::vector<cv::Point2d> pt, pr;
       for (std::size_t k = 0; k < r.est.size(); ++k) {
@@ -206,8 +219,8 @@ std::string write_keyframe_bars(const fs::path& dir, const nlohmann::json& summa
       if (s.is_object()) max_kf = std::max(max_kf, s["max"].get<double>());
     }
   }
-  const auto ticks = eval::nice_ticks(0, max_kf, 6);
-  const double y_max = std::max(max_kf, ticks.empty() ? max_kf : ticks.back());
+  const auto ticks = eval::nice_ticks(0, 1.1 * max_kf, 6);
+  const double y_max = std::max(1.1 * max_kf, ticks.empty() ? max_kf : ticks.back());
   auto y_of = [&](double v) { return plot.y + plot.height - static_cast<int>(std::lround(v / y_max * plot.height)); };
   const int font = cv::FONT_HERSHEY_SIMPLEX;
   cv::putText(img, "Keyframes per dataset and configuration (bars: median, whiskers: min-max)", {left, 35}, font, 0.7, kBlack, 2,
