@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fuzz/targets/fuzz_bench_configs.cpp"
 #include "fuzz/targets/fuzz_config.cpp"
 #include "fuzz/targets/fuzz_datasets.cpp"
 #include "fuzz/targets/fuzz_euroc_sensor.cpp"
@@ -38,6 +39,7 @@ const Target kTargets[] = {
     {"frame_log", fuzz_frame_log},
     {"image", fuzz_image},
     {"vocabulary", fuzz_vocabulary},
+    {"bench_configs", fuzz_bench_configs},
 };
 
 class FuzzReplay : public testing::TestWithParam<Target> {};

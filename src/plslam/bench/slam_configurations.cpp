@@ -1,6 +1,7 @@
 #include "plslam/bench/slam_configurations.h"
 
 #include <algorithm>
+#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -39,49 +40,64 @@ void validate_slam_configuration(const SlamConfiguration& c, const std::string& 
   }
 }
 
-std::vector<SlamConfiguration> load_slam_configurations(const std::filesystem::path& file) {
-  const std::string src = file.string();
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(src);
-  } catch (const YAML::BadFile&) {
-    throw InputError(src, "cannot open the configurations file");
-  } catch (const YAML::Exception& e) {
-    throw InputError(src, std::string("malformed YAML: ") + e.msg);
-  }
+namespace {
+
+std::vector<SlamConfiguration> parse_configurations(const YAML::Node& root, const std::string& src) {
   if (!root.IsMap() || !root["configs"] || !root["configs"].IsMap() || root["configs"].size() == 0) {
     throw InputError(src, "expected a non-empty map 'configs: {name: {overrides: {...}}}'");
   }
   for (const auto& kv : root) {
-    if (kv.first.as<std::string>() != "configs") throw InputError(src, "unknown key " + kv.first.as<std::string>());
+    if (!kv.first.IsScalar() || kv.first.Scalar() != "configs") throw InputError(src, "unknown key at the top: only 'configs'");
   }
   std::vector<SlamConfiguration> out;
+  std::set<std::string> names;
   for (const auto& kv : root["configs"]) {
+    if (!kv.first.IsScalar()) throw InputError(src, "configs: a name must be text");
     SlamConfiguration c;
-    c.name = kv.first.as<std::string>();
+    c.name = kv.first.Scalar();
     if (!valid_configuration_name(c.name)) {
       throw InputError(src, "configs." + c.name + ": a name holds letters, digits, '-', '_' or '.'");
     }
+    if (!names.insert(c.name).second) throw InputError(src, "configs." + c.name + ": defined twice");
     const YAML::Node body = kv.second;
     if (!body.IsMap()) throw InputError(src, "configs." + c.name + ": expected a map with 'overrides'");
     for (const auto& field : body) {
-      const auto key = field.first.as<std::string>();
+      const std::string key = field.first.IsScalar() ? field.first.Scalar() : std::string("?");
       if (key != "description" && key != "overrides") throw InputError(src, "configs." + c.name + "." + key + ": unknown key");
     }
     if (body["description"]) {
       if (!body["description"].IsScalar()) throw InputError(src, "configs." + c.name + ".description: expected text");
-      c.description = body["description"].as<std::string>();
+      c.description = body["description"].Scalar();
     }
     if (body["overrides"]) {
       if (!body["overrides"].IsMap()) throw InputError(src, "configs." + c.name + ".overrides: expected a map");
       YAML::Emitter e;
       e << body["overrides"];
+      if (!e.good()) throw InputError(src, "configs." + c.name + ".overrides: " + e.GetLastError());
       c.yaml = std::string(e.c_str()) + "\n";
     }
     validate_slam_configuration(c, src);
     out.push_back(std::move(c));
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<SlamConfiguration> parse_slam_configurations(const std::string& text, const std::string& source) {
+  try {
+    return parse_configurations(YAML::Load(text), source);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source, std::string("malformed YAML: ") + e.msg);
+  }
+}
+
+std::vector<SlamConfiguration> load_slam_configurations(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in || std::filesystem::is_directory(file)) throw InputError(file.string(), "cannot open the configurations file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_slam_configurations(text.str(), file.string());
 }
 
 std::vector<SlamConfiguration> select_slam_configurations(const std::string& list,

@@ -25,6 +25,8 @@ std::vector<SlamConfiguration> builtin_slam_configurations();
 // Every configuration is checked against both presets (unknown keys and bad values fail, naming
 // the file and the configuration). Paths inside the overrides must be absolute.
 std::vector<SlamConfiguration> load_slam_configurations(const std::filesystem::path& file);
+// The same from the file's text (`source` names it in errors); the parser the fuzzer drives.
+std::vector<SlamConfiguration> parse_slam_configurations(const std::string& text, const std::string& source);
 
 // `list` is "all" or comma-separated names from `available`, in the order given. Throws
 // InputError naming an unknown or repeated name.
