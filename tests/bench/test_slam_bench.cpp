@@ -105,6 +105,11 @@ TEST(SlamConfigurations, AUserFileIsCheckedKeyByKeyAgainstThePresets) {
                    "  plain:\n    overrides: {}\n");
   const auto c = load_slam_configurations(good);
   ASSERT_EQ(c.size(), 2u);
+  EXPECT_FALSE(disables_loop_closing(c[0]));
+  const auto odo = parse_slam_configurations("configs:\n  odo:\n    overrides:\n      loop:\n        enabled: false\n", "t");
+  ASSERT_EQ(odo.size(), 1u);
+  EXPECT_TRUE(disables_loop_closing(odo[0]));
+  EXPECT_EQ(bench_rows(odo, "anchor").back().name, "anchor-no-loop-closing");
   EXPECT_EQ(c[0].name, "dense-kf");
   EXPECT_EQ(c[0].description, "more keyframes");
   EXPECT_NE(c[0].yaml.find("ratio"), std::string::npos);

@@ -21,7 +21,7 @@ std::vector<BenchRow> bench_rows(const std::vector<SlamConfiguration>& configs, 
   bool odometry = false;
   for (const auto& c : configs) {
     rows.push_back({c.name, false, true, c});
-    odometry = odometry || c.name == "no-loop-closing";
+    odometry = odometry || disables_loop_closing(c);
   }
   if (!anchor_name.empty()) {
     rows.push_back({anchor_name, true, true, {}});
@@ -221,7 +221,7 @@ json summarize_runs(const json& results, const std::vector<BenchDataset>& datase
       }
       if (!row.anchor) {
         // Against the anchor with the same loop-closing setting.
-        const bool odometry = row.config.yaml.find("loop: {enabled: false}") != std::string::npos;
+        const bool odometry = disables_loop_closing(row.config);
         for (const auto& a : rows) {
           if (!a.anchor || a.anchor_loop_closing == odometry) continue;
           s["ratio_to_anchor"] = {{"anchor", a.name},

@@ -36,8 +36,8 @@ struct BenchJob {
   int run = 1;  // 1-based
 };
 
-// The rows: the configurations, then, with an anchor, "anchor" (its loop closing on) and, when
-// the configurations include no-loop-closing, "anchor-no-loop-closing".
+// The rows: the configurations, then, with an anchor, "anchor" (its loop closing on) and, when a
+// configuration switches loop closing off, "anchor-no-loop-closing".
 std::vector<BenchRow> bench_rows(const std::vector<SlamConfiguration>& configs, const std::string& anchor_name);
 
 // Run 1 of every dataset and row, then run 2, ...: the rows alternate run by run.

@@ -40,6 +40,12 @@ void validate_slam_configuration(const SlamConfiguration& c, const std::string& 
   }
 }
 
+bool disables_loop_closing(const SlamConfiguration& c) {
+  const auto options = system::apply_config(ConfigReader::from_string(c.yaml, c.name),
+                                            system::load_system_options(io::DatasetFormat::kEuroc, std::nullopt));
+  return !options.loop_closing;
+}
+
 namespace {
 
 std::vector<SlamConfiguration> parse_configurations(const YAML::Node& root, const std::string& src) {

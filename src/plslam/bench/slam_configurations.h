@@ -36,6 +36,10 @@ std::vector<SlamConfiguration> select_slam_configurations(const std::string& lis
 // Throws InputError (source: `source`) when the overrides do not apply to the EuRoC or KITTI preset.
 void validate_slam_configuration(const SlamConfiguration& c, const std::string& source);
 
+// Whether the configuration switches loop closing off (it is then compared with an anchor run
+// without loop closing).
+bool disables_loop_closing(const SlamConfiguration& c);
+
 // Names are used as folder names: letters, digits, '-', '_' and '.', not starting with '.'.
 bool valid_configuration_name(const std::string& name);
 
