@@ -133,6 +133,22 @@ std::vector<std::string> job_argv(const bench::BenchRow& row, const fs::path& da
   return argv;
 }
 
+// The command as given, to head the report (arguments with spaces quoted).
+std::string command_line(const BenchSlamArgs& a) {
+  auto arg = [](const std::string& v) { return v.find_first_of(" \t'\"") == std::string::npos ? v : "'" + v + "'"; };
+  std::string c = "plslam bench slam";
+  for (const auto& d : a.datasets) c += " " + arg(d);
+  if (!a.preset.empty()) c += " --preset " + a.preset;
+  c += fmt::format(" --runs {}", a.runs);
+  if (a.configs != "all") c += " --configs " + arg(a.configs);
+  if (!a.config_file.empty()) c += " --config-file " + arg(a.config_file);
+  if (!a.anchor.empty()) c += " --anchor " + arg(a.anchor);
+  if (!a.shared.empty()) c += " --shared " + arg(a.shared);
+  if (a.sequential) c += " --sequential";
+  if (a.table1_frames != 20) c += fmt::format(" --table1-frames {}", a.table1_frames);
+  return c + " --out " + arg(a.out);
+}
+
 // The successful run whose ATE is the median of its row (the lower middle for an even count).
 std::optional<json> median_run(const json& results, const std::string& dataset, const std::string& row) {
   std::vector<json> ok;
@@ -240,7 +256,7 @@ int run_bench_slam(const BenchSlamArgs& a) {
   }
 
   json report;
-  report["command"] = "plslam bench slam";
+  report["command"] = command_line(a);
   report["version"] = kVersion;
   report["date"] = now_utc();
   report["hardware_threads"] = std::thread::hardware_concurrency();

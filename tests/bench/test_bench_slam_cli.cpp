@@ -87,6 +87,9 @@ TEST(BenchSlamCli, QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequen
   const auto md = test::read_file(seq / "report.md");
   for (const auto& name : names) EXPECT_NE(md.find("| " + name + " |"), std::string::npos) << name;
   EXPECT_NE(md.find("Table I"), std::string::npos);
+  EXPECT_NE(report["command"].get<std::string>().find("--preset quick --runs 1 --sequential --table1-frames 3 --out "),
+            std::string::npos)
+      << report["command"];
 
   const auto dataset = seq / "data" / "office-quick";
   for (const std::string config : {"full", "no-lines"}) {
