@@ -1,8 +1,9 @@
 #pragma once
 // The figures of `plslam bench slam`, drawn with the eval library's Chart: per dataset, the
 // trajectories against the ground truth (top view aligned, top view aligned at the first pose
-// only, and an oblique 3D view), translation and rotation error over time, and per-frame tracking
-// time; over all datasets, the keyframe counts as grouped bars.
+// only, and an oblique 3D view), translation error over time and rotation drift since the first
+// pose (free of the alignment), and per-frame tracking time; over all datasets, the keyframe
+// counts as grouped bars.
 #include <filesystem>
 #include <string>
 #include <vector>
