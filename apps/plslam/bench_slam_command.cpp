@@ -124,7 +124,7 @@ std::vector<std::string> job_argv(const bench::BenchRow& row, const fs::path& da
                                   const fs::path& out, const BenchSlamArgs& a) {
   if (row.anchor) {
     std::vector<std::string> argv = {a.anchor, dataset.string(), "--out", folder.string()};
-    if (!row.anchor_loop_closing) argv.push_back("--no-loop-closing");
+    if (!row.loop_closing) argv.push_back("--no-loop-closing");
     return argv;
   }
   std::vector<std::string> argv = {current_executable().string(), "run", dataset.string(), "--out", folder.string(),
@@ -269,7 +269,7 @@ int run_bench_slam(const BenchSlamArgs& a) {
   if (!a.anchor.empty()) {
     report["configurations"].push_back({{"name", "anchor"}, {"description", "the anchor " + a.anchor + ", its defaults"}, {"overrides", ""}});
     for (const auto& r : rows) {
-      if (r.anchor && !r.anchor_loop_closing) {
+      if (r.anchor && !r.loop_closing) {
         report["configurations"].push_back({{"name", r.name}, {"description", "the anchor with --no-loop-closing"}, {"overrides", ""}});
       }
     }
@@ -308,9 +308,8 @@ int run_bench_slam(const BenchSlamArgs& a) {
       fr.push_back(std::move(f));
     }
     if (fr.empty()) continue;
-    const bool by_frame = false;
     json names = json::array();
-    for (const auto& n : bench::write_dataset_figures(fig_dir, datasets[i].name, *opened[i]->ground_truth(), fr, by_frame)) {
+    for (const auto& n : bench::write_dataset_figures(fig_dir, datasets[i].name, *opened[i]->ground_truth(), fr)) {
       names.push_back("figures/" + n);
     }
     figures[datasets[i].name] = names;

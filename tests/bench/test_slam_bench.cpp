@@ -60,9 +60,11 @@ TEST(SlamBenchPlan, AnchorRowsFollowTheConfigurationsWithAnOdometryTwinWhenAsked
   auto rows = bench_rows(all, "anchor");
   ASSERT_EQ(rows.size(), all.size() + 2);
   EXPECT_TRUE(rows[all.size()].anchor);
-  EXPECT_TRUE(rows[all.size()].anchor_loop_closing);
+  EXPECT_TRUE(rows[all.size()].loop_closing);
   EXPECT_EQ(rows.back().name, "anchor-no-loop-closing");
-  EXPECT_FALSE(rows.back().anchor_loop_closing);
+  EXPECT_FALSE(rows.back().loop_closing);
+  EXPECT_FALSE(rows[all.size() - 1].loop_closing);  // no-loop-closing
+  EXPECT_TRUE(rows[0].loop_closing);
   rows = bench_rows(select_slam_configurations("full,no-lines", all), "anchor");
   EXPECT_EQ(rows.size(), 3u);
   EXPECT_EQ(bench_rows(all, "").size(), all.size());

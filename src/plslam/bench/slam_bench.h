@@ -21,8 +21,8 @@ namespace plslam::bench {
 struct BenchRow {
   std::string name;
   bool anchor = false;
-  bool anchor_loop_closing = true;  // anchors only
-  SlamConfiguration config;         // plslam rows only
+  bool loop_closing = true;  // plslam rows: read from the applied configuration
+  SlamConfiguration config;  // plslam rows only
 };
 
 struct BenchDataset {
@@ -58,7 +58,7 @@ std::filesystem::path run_folder(const std::filesystem::path& out, const BenchDa
 // "error" says why a run has no score.
 nlohmann::json measure_run(const io::Dataset& dataset, const std::filesystem::path& folder, bool anchor);
 
-// Metric keys in report order, with the label and the unit used in report.md.
+// Metric keys in report order, with their column label in report.md and decimals.
 struct MetricInfo {
   const char* key;
   const char* label;

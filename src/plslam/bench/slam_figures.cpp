@@ -51,9 +51,6 @@ Trajectory at_first_pose(const FigureRun& run, const Trajectory& gt) {
   return out;
 }
 
-double time_of(const Trajectory& t, std::size_t i, bool x_is_frame) {
-  return x_is_frame ? static_cast<double>(i) : t[i].t - t.front().t;
-}
 
 using Projection = std::function<cv::Point2d(const Eigen::Vector3d&)>;
 using NamedTrajectories = std::vector<std::pair<std::string, Trajectory>>;
@@ -127,14 +124,14 @@ std::vector<double> read_frame_times(const fs::path& folder) {
 }
 
 std::vector<std::string> write_dataset_figures(const fs::path& dir, const std::string& dataset, const Trajectory& gt,
-                                               const std::vector<FigureRun>& runs, bool x_is_frame) {
+                                               const std::vector<FigureRun>& runs) {
   std::vector<std::string> written;
   NamedTrajectories aligned, first_pose;
   for (const auto& r : runs) {
     aligned.emplace_back(r.row, r.result.est);
     first_pose.emplace_back(r.row, at_first_pose(r, gt));
   }
-  const std::string x_label = x_is_frame ? "frame" : "time [s]";
+  const std::string x_label = "time [s]";
 
   auto name = [&](const char* what) { return fmt::format("{}_{}.png", dataset, what); };
   top_view(dataset + ": top view, SE(3)-aligned (median-ATE run of each row)", gt, aligned, dir / name("trajectory"));
@@ -172,7 +169,7 @@ std::vector<std::string> write_dataset_figures(const fs::path& dir, const std::s
       const auto& r = runs[i].result;
       std::vector<cv::Point2d> pt, pr;
       for (std::size_t k = 0; k < r.est.size(); ++k) {
-        const double x = time_of(r.gt, k, x_is_frame);
+        const double x = r.gt[k].t - r.gt.front().t;
         pt.emplace_back(x, r.ape_trans_m[k]);
         // Rotation drift since the first pose: free of the alignment, whose rotation a short or
         // straight path leaves undetermined (EuRoC micro moves about a millimetre).

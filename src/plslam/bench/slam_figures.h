@@ -31,8 +31,7 @@ std::vector<double> read_frame_times(const std::filesystem::path& folder);
 // Writes <dataset>_trajectory.png, <dataset>_trajectory_first_pose.png, <dataset>_trajectory_3d.png,
 // <dataset>_errors.png and <dataset>_tracking_ms.png into `dir`; returns the file names written.
 std::vector<std::string> write_dataset_figures(const std::filesystem::path& dir, const std::string& dataset,
-                                               const Trajectory& ground_truth, const std::vector<FigureRun>& runs,
-                                               bool x_is_frame);
+                                               const Trajectory& ground_truth, const std::vector<FigureRun>& runs);
 
 // keyframes.png: median keyframes per dataset (groups) and row (bars). Returns the file name.
 std::string write_keyframe_bars(const std::filesystem::path& dir, const nlohmann::json& summary,

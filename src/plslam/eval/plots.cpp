@@ -21,7 +21,6 @@ const cv::Scalar kBlue(180, 119, 31), kOrange(14, 127, 255), kGreen(44, 160, 44)
 
 constexpr std::array<const char*, 3> kAxisNames = {"x", "y", "z"};
 
-
 void add_statistic_lines(Chart& c, const ErrorStatistics& s, const char* unit) {
   c.add_hline(s.rmse, {kRed, 2, false}, fmt::format("rmse {:.4g} {}", s.rmse, unit));
   c.add_hline(s.mean, {kGreen, 2, true}, fmt::format("mean {:.4g} {}", s.mean, unit));
