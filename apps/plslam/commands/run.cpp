@@ -15,12 +15,15 @@
 #include "stop_signals.h"
 #include "commands/dataset_options.h"
 #include "plslam/core/error.h"
+#include "plslam/core/stopwatch.h"
+#include "plslam/core/version.h"
 #include "plslam/io/atomic_file.h"
 #include "plslam/io/frame_stream.h"
 #include "plslam/io/map_export.h"
 #include "plslam/io/output_folder.h"
 #include "plslam/io/trajectory_io.h"
 #include "plslam/system/input_aligned_trajectory.h"
+#include "plslam/system/map_file.h"
 #include "plslam/system/run_report.h"
 #include "plslam/system/slam_system.h"
 #include "plslam/system/system_config.h"
@@ -52,12 +55,32 @@ struct RunArgs {
   bool realtime = false;
   bool sequential = false;
   int repeat = 1;
+  std::string save_map;  // --save-map FILE
+  std::string load_map;  // --load-map FILE
+  bool localize = false; // --localize
 };
+
+// What a map file records as the configuration that built it: the preset, the config file's
+// text and the switches given on the command line.
+std::string map_config_text(const RunArgs& args, io::DatasetFormat format) {
+  nlohmann::json j = {{"preset", format == io::DatasetFormat::kKitti ? "kitti" : "euroc"},
+                      {"config_file", args.config},
+                      {"no_lines", args.no_lines},
+                      {"no_loop_closing", args.no_loop_closing},
+                      {"sequential", args.sequential},
+                      {"loaded_map", args.load_map}};
+  if (!args.config.empty()) {
+    std::ifstream in(args.config);
+    j["config"] = std::string(std::istreambuf_iterator<char>(in), {});
+  }
+  return j.dump(2);
+}
 
 // One run into `out_dir`; its stats.json content is left in `stats_out`.
 int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats_out) {
   // Checked before any frame: a bad --out must not be found only when the outputs are written.
   io::prepare_output_folder(out_dir);
+  if (!args.save_map.empty()) io::prepare_output_file(args.save_map, "--save-map");
   const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
   auto options = system::load_system_options(
       ds->format(), args.config.empty() ? std::nullopt : std::optional<fs::path>(args.config));
@@ -66,7 +89,17 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   if (!args.vocabulary.empty()) options.vocabulary = args.vocabulary;
   if (args.no_place_recognition) options.place_recognition = false;
   if (args.no_loop_closing) options.loop_closing = false;
+  options.localization_only = args.localize;
   const auto vocabulary = system::load_vocabulary(options);  // InputError naming the file
+  std::optional<system::MapContents> loaded;
+  std::optional<geometry::SE3> gt_anchor;  // of the loaded map
+  const auto load_start = std::chrono::steady_clock::now();
+  double read_ms = 0;
+  if (!args.load_map.empty()) {
+    loaded = system::load_map_file(args.load_map);
+    system::check_map_matches(loaded->meta, ds->calibration(), vocabulary.get(), args.load_map);
+    read_ms = ms_since(load_start);
+  }
 
   spdlog::info("{}: {} frames, {}x{}, {:.1f} fps, baseline {:.3f} m, lines {}, place recognition {}", ds->root().string(),
                ds->size(), ds->calibration().width, ds->calibration().height, ds->fps(), ds->calibration().baseline,
@@ -74,6 +107,19 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
                vocabulary ? fmt::format("on ({} words)", vocabulary->size()) : std::string("off"));
 
   system::System slam(ds->calibration(), options, vocabulary);
+  nlohmann::json map_stats = {{"loaded", args.load_map.empty() ? nlohmann::json(nullptr) : nlohmann::json(args.load_map)},
+                               {"localization_only", args.localize},
+                               {"saved", nullptr}};
+  if (loaded) {
+    gt_anchor = loaded->meta.T_gt_map;
+    const auto t0 = std::chrono::steady_clock::now();
+    slam.load_map(*loaded);
+    const double restore_ms = ms_since(t0);
+    map_stats["load"] = {{"keyframes", loaded->keyframes.size()}, {"read_ms", read_ms}, {"restore_ms", restore_ms}};
+    spdlog::info("{}: {} keyframes, {} points, {} lines; read in {:.1f} ms, restored in {:.1f} ms", args.load_map,
+                 loaded->keyframes.size(), loaded->points.size(), loaded->lines.size(), read_ms, restore_ms);
+    loaded.reset();
+  }
   system::RunReport report;
   app::install_stop_signals();
   std::string fatal;
@@ -121,18 +167,43 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   }
   slam.finish();
 
+  if (!args.save_map.empty() && slam.map().first_keyframe()) {
+    // After local mapping and loop closing (and its global BA) finished: the map as it ends.
+    const auto t0 = std::chrono::steady_clock::now();
+    system::MapFileMeta meta;
+    meta.created_by = fmt::format("plslam {} run {}", kVersion, ds->root().string());
+    meta.config = map_config_text(args, ds->format());
+    if (gt_anchor) {
+      meta.T_gt_map = gt_anchor;  // a loaded map keeps the anchor it came with
+    } else if (const auto* first = slam.map().first_keyframe(); first && !first->is_bad()) {
+      meta.T_gt_map = system::ground_truth_anchor(*ds, *first);
+    }
+    const auto contents = slam.capture_map(std::move(meta));
+    system::save_map_file(args.save_map, contents);
+    map_stats["saved"] = args.save_map;
+    map_stats["save"] = {{"keyframes", contents.keyframes.size()}, {"ms", ms_since(t0)}};
+    spdlog::info("map saved to {} ({:.1f} ms)", args.save_map, ms_since(t0));
+  }
+
   if (!slam.initialized_at()) {
     // No pose was ever tracked: an identity trajectory would look perfect to an evaluator, so
     // none is written; stats.json says what happened.
     stats_out = with_interruption(report.to_json(slam));
+    stats_out["map"] = map_stats;
     const auto stats_text = stats_out.dump(2);
     io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats_text << "\n"; });
     if (!fatal.empty()) throw InputError("", fatal);
     if (app::stop_requested()) return app::stop_exit_code();
-    std::cerr << fmt::format(
-        "plslam: error: {}: tracking never initialised in {} frames (no frame had {} stereo points); "
-        "no trajectory written\n",
-        ds->root().string(), report.frames, options.tracker.init_min_points);
+    if (!args.load_map.empty()) {
+      std::cerr << fmt::format("plslam: error: {}: the camera was never found in the map {} in {} frames; "
+                               "no trajectory written\n",
+                               ds->root().string(), args.load_map, report.frames);
+    } else {
+      std::cerr << fmt::format(
+          "plslam: error: {}: tracking never initialised in {} frames (no frame had {} stereo points); "
+          "no trajectory written\n",
+          ds->root().string(), report.frames, options.tracker.init_min_points);
+    }
     return kExitNotInitialized;
   }
 
@@ -155,6 +226,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   io::write_ply_lines(out_dir / "map_lines.ply", lines);
 
   auto stats = with_interruption(report.to_json(slam));
+  stats["map"] = map_stats;
   if (ds->ground_truth()) {
     // Tracked poses only: a prediction made while lost is not an estimate to score.
     try {
@@ -165,6 +237,18 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
       // Too few tracked poses to score (or a degenerate alignment): say so instead of a number.
       spdlog::warn("no accuracy: {}", e.what());
       stats["accuracy"] = {{"error", e.what()}};
+    }
+    if (gt_anchor) {
+      // Same ground-truth world as the run that made the map: positions in the map's frame,
+      // with no alignment, are the localization error itself.
+      try {
+        const auto in_map = system::evaluate_in_map_frame(*ds, traj, *gt_anchor);
+        stats["accuracy_in_map_frame"] = in_map;
+        std::cout << fmt::format("position error in the map's frame (no alignment): rmse {:.4f} m over {} poses\n",
+                                 in_map["ape_trans_m"]["rmse"].get<double>(), in_map["pairs"].get<std::size_t>());
+      } catch (const InputError& e) {
+        stats["accuracy_in_map_frame"] = {{"error", e.what()}};
+      }
     }
   }
   io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats.dump(2) << "\n"; });
@@ -232,6 +316,13 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                            sub.add_flag("--realtime", args->realtime, "Pace the input at the dataset's frame rate");
                            sub.add_flag("--sequential", args->sequential,
                                         "Run local mapping and loop closing in the tracking thread (reproducible runs)");
+                           sub.add_option("--save-map", args->save_map,
+                                          "Save the map at the end (after loop closing) to FILE (.plmap)");
+                           auto* load = sub.add_option("--load-map", args->load_map,
+                                                       "Start in the map of FILE: relocalize in it, then keep mapping it");
+                           sub.add_flag("--localize", args->localize,
+                                        "With --load-map: localization only (no new keyframes, points or lines)")
+                               ->needs(load);
                            sub.add_option("--repeat", args->repeat,
                                           "Run N times into DIR/run-1..N and report the ATE's median, min and max")
                                ->check(CLI::Range(1, 1000));

@@ -25,6 +25,7 @@ struct Options {
   std::string preset = "euroc";
   int frames = 200;
   std::uint64_t seed = 1;
+  std::uint64_t path_seed = 0;
   bool loop = false;
   double loop_overlap = plslam::synth::SequenceOptions{}.loop_overlap;
   double fps = 0;  // 0: the preset's
@@ -102,6 +103,7 @@ int run(const Options& o) {
   if (o.fps > 0) so.preset.fps = o.fps;
   so.frames = o.frames;
   so.seed = o.seed;
+  so.path_seed = o.path_seed;
   so.loop = o.loop;
   so.loop_overlap = o.loop_overlap;
   so.motion_blur = o.motion_blur;
@@ -112,6 +114,11 @@ int run(const Options& o) {
   spdlog::info("synth: {} scene, {} preset ({}x{} @ {:.4g} Hz, baseline {} m), {} frames, path {:.1f} m at {:.2f} m/s{}",
                o.scene, so.preset.name, so.preset.width, so.preset.height, so.preset.fps, so.preset.baseline,
                o.frames, seq.path().length(), seq.path().speed(), o.loop ? ", loop" : "");
+  if (o.path_seed != 0) {
+    const auto v = plslam::synth::path_variation(o.path_seed, seq.scene().vehicle);
+    spdlog::info("synth: path seed {}: starts at {:.0f} % of the loop, {}, {:+.2f} m to the left, {:+.2f} m up",
+                 o.path_seed, 100 * v.start, v.reverse ? "travelled in reverse" : "same direction", v.lateral, v.height);
+  }
   const auto start = std::chrono::steady_clock::now();
   std::size_t last = 0;
   StagingFolder staging(out);
@@ -151,6 +158,11 @@ plslam::cli::CommandRegistration reg({"synth", "Render a synthetic stereo sequen
                                                        "the same path with fewer, further-apart frames)")
                                             ->check(CLI::Range(0.5, 1000.0));
                                         sub.add_option("--seed", o->seed, "Seed for textures and motion")
+                                            ->check(CLI::NonNegativeNumber)
+                                            ->capture_default_str();
+                                        sub.add_option("--path-seed", o->path_seed,
+                                                       "Another path through the same scene (0: the scene's own): start "
+                                                       "point, direction and a small sideways and height offset")
                                             ->check(CLI::NonNegativeNumber)
                                             ->capture_default_str();
                                         auto* loop = sub.add_flag("--loop", o->loop, "Close a loop of >= 30 m and return to the start");

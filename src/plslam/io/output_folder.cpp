@@ -32,4 +32,17 @@ void prepare_output_folder(const std::filesystem::path& dir) {
   if (!ok) throw InputError(dir.string(), "output folder is not writable");
 }
 
+void prepare_output_file(const std::filesystem::path& path, const char* option) {
+  namespace fs = std::filesystem;
+  if (path.empty()) throw InputError(option, "output file is an empty string");
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw InputError(path.string(), "output file is a folder");
+  const fs::path parent = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  try {
+    prepare_output_folder(parent);
+  } catch (const InputError& e) {
+    throw InputError(path.string(), "cannot write here: " + e.problem());
+  }
+}
+
 }  // namespace plslam::io

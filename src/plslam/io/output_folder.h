@@ -8,4 +8,8 @@ namespace plslam::io {
 // Throws InputError naming `dir` when it is empty, a file, or not writable.
 void prepare_output_folder(const std::filesystem::path& dir);
 
+// The same for a single output file (`option` names the flag in messages): its folder is
+// prepared, and the path must not be an existing folder.
+void prepare_output_file(const std::filesystem::path& path, const char* option);
+
 }  // namespace plslam::io

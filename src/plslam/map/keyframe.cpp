@@ -226,6 +226,19 @@ void KeyFrame::add_loop_edge(KeyFrame* kf) {
   loop_edges_.insert(kf);
 }
 
+void KeyFrame::restore_graph(KeyFrame* parent, const IdMap<KeyFrame, int>& weights,
+                             const IdSet<KeyFrame>& loop_edges) {
+  {
+    std::lock_guard lock(graph_mutex_);
+    weights_ = weights;
+    sort_connections_locked();
+    loop_edges_ = loop_edges;
+    first_connection_ = false;
+    parent_ = parent;
+  }
+  if (parent) parent->add_child(this);
+}
+
 IdSet<KeyFrame> KeyFrame::loop_edges() const {
   std::lock_guard lock(graph_mutex_);
   return loop_edges_;

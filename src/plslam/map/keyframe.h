@@ -73,6 +73,11 @@ class KeyFrame {
   void add_loop_edge(KeyFrame* kf);
   IdSet<KeyFrame> loop_edges() const;
 
+  // A keyframe read from a map file: its covisibility weights, spanning-tree parent (null for a
+  // root) and loop edges as saved. It counts as connected, so update_connections() never
+  // re-attaches it to the tree.
+  void restore_graph(KeyFrame* parent, const IdMap<KeyFrame, int>& weights, const IdSet<KeyFrame>& loop_edges);
+
   // Never removes the first keyframe. Otherwise: detaches from points, lines and the graph,
   // re-parents its children to their best covisible candidate, and remembers its pose relative
   // to its parent so that frames that referenced it keep a valid pose.

@@ -62,6 +62,17 @@ class Landmark {
   void replace_with(Derived* other);
   Derived* replaced_by() const;
 
+  // What a map file stores beyond the position and the observations (system/map_file): restored
+  // as saved rather than recomputed, so that save -> load -> save gives the same bytes.
+  struct SavedState {
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    double min_distance = 0, max_distance = 0;
+    cv::Mat descriptor;
+    int visible = 1, found = 1;
+  };
+  SavedState saved_state() const;
+  void restore_state(const SavedState& s);
+
  protected:
   // For update_normal_and_depth() of the derived class: the mean viewing direction and range.
   void set_normal_and_range(const Eigen::Vector3d& normal, double min_distance, double max_distance);

@@ -183,6 +183,23 @@ void Landmark<D>::replace_with(D* other) {
 }
 
 template <class D>
+typename Landmark<D>::SavedState Landmark<D>::saved_state() const {
+  std::lock_guard lock(mutex_);
+  return {normal_, min_distance_, max_distance_, descriptor_.clone(), visible_, found_};
+}
+
+template <class D>
+void Landmark<D>::restore_state(const SavedState& s) {
+  std::lock_guard lock(mutex_);
+  normal_ = s.normal;
+  min_distance_ = s.min_distance;
+  max_distance_ = s.max_distance;
+  descriptor_ = s.descriptor.clone();
+  visible_ = s.visible;
+  found_ = s.found;
+}
+
+template <class D>
 D* Landmark<D>::replaced_by() const {
   std::lock_guard lock(mutex_);
   return replaced_by_;

@@ -1,5 +1,9 @@
 #include "plslam/map/map.h"
 
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
 namespace plslam::map {
 
 KeyFrame* Map::create_keyframe(std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw) {
@@ -22,6 +26,55 @@ MapLine* Map::create_line(const Eigen::Vector3d& start, const Eigen::Vector3d& e
   all_lines_.push_back(std::make_unique<MapLine>(next_line_id_++, start, end, reference, frame_id));
   lines_.insert(all_lines_.back().get());
   return all_lines_.back().get();
+}
+
+KeyFrame* Map::restore_keyframe(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw) {
+  std::lock_guard lock(mutex_);
+  if (id < 0) throw std::invalid_argument("negative keyframe id");
+  all_keyframes_.push_back(std::make_unique<KeyFrame>(id, std::move(data), T_cw));
+  if (!keyframes_.insert(all_keyframes_.back().get()).second) {
+    all_keyframes_.pop_back();
+    throw std::invalid_argument("duplicate keyframe id " + std::to_string(id));
+  }
+  next_keyframe_id_ = std::max(next_keyframe_id_, id + 1);
+  return all_keyframes_.back().get();
+}
+
+MapPoint* Map::restore_point(long id, const Eigen::Vector3d& position, KeyFrame* reference, long frame_id) {
+  std::lock_guard lock(mutex_);
+  if (id < 0) throw std::invalid_argument("negative point id");
+  all_points_.push_back(std::make_unique<MapPoint>(id, position, reference, frame_id));
+  if (!points_.insert(all_points_.back().get()).second) {
+    all_points_.pop_back();
+    throw std::invalid_argument("duplicate point id " + std::to_string(id));
+  }
+  next_point_id_ = std::max(next_point_id_, id + 1);
+  return all_points_.back().get();
+}
+
+MapLine* Map::restore_line(long id, const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
+                           long frame_id) {
+  std::lock_guard lock(mutex_);
+  if (id < 0) throw std::invalid_argument("negative line id");
+  all_lines_.push_back(std::make_unique<MapLine>(id, start, end, reference, frame_id));
+  if (!lines_.insert(all_lines_.back().get()).second) {
+    all_lines_.pop_back();
+    throw std::invalid_argument("duplicate line id " + std::to_string(id));
+  }
+  next_line_id_ = std::max(next_line_id_, id + 1);
+  return all_lines_.back().get();
+}
+
+Map::NextIds Map::next_ids() const {
+  std::lock_guard lock(mutex_);
+  return {next_keyframe_id_, next_point_id_, next_line_id_};
+}
+
+void Map::restore_next_ids(const NextIds& next) {
+  std::lock_guard lock(mutex_);
+  next_keyframe_id_ = std::max(next_keyframe_id_, next.keyframe);
+  next_point_id_ = std::max(next_point_id_, next.point);
+  next_line_id_ = std::max(next_line_id_, next.line);
 }
 
 void Map::erase_keyframe(KeyFrame* kf) {

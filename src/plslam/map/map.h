@@ -25,6 +25,19 @@ class Map {
   MapLine* create_line(const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
                        long frame_id);
 
+  // Objects read from a map file keep their saved ids (system/map_file); an id already in use
+  // throws std::invalid_argument. The next ids are restored as saved, so that objects created
+  // after loading never reuse an id.
+  KeyFrame* restore_keyframe(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw);
+  MapPoint* restore_point(long id, const Eigen::Vector3d& position, KeyFrame* reference, long frame_id);
+  MapLine* restore_line(long id, const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
+                        long frame_id);
+  struct NextIds {
+    long keyframe = 0, point = 0, line = 0;
+  };
+  NextIds next_ids() const;
+  void restore_next_ids(const NextIds& next);
+
   // Removes from the active sets (the object stays alive until the Map is destroyed).
   void erase_keyframe(KeyFrame* kf);
   void erase_point(MapPoint* p);

@@ -57,6 +57,16 @@ void MapPoint::update_normal_and_depth() {
   level0_max_distance_ = max_d;
 }
 
+double MapPoint::level0_max_distance() const {
+  std::lock_guard lock(mutex_);
+  return level0_max_distance_;
+}
+
+void MapPoint::restore_level0_max_distance(double d) {
+  std::lock_guard lock(mutex_);
+  level0_max_distance_ = d;
+}
+
 int MapPoint::predict_level(double distance, int levels, double scale_factor) const {
   double ratio = 0;
   {

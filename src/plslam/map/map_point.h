@@ -20,6 +20,9 @@ class MapPoint : public Landmark<MapPoint> {
   void update_normal_and_depth();
   // Pyramid level at which a point seen at `distance` should be detected.
   int predict_level(double distance, int levels, double scale_factor) const;
+  // The distance at which it would be seen at level 0 (map files store it as is).
+  double level0_max_distance() const;
+  void restore_level0_max_distance(double d);
 
   // Where a point sits in a keyframe (Landmark's CRTP hooks).
   static MapPoint* slot(const KeyFrame& kf, int index);

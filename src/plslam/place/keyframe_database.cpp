@@ -21,7 +21,10 @@ PlaceDescription KeyframeDatabase::describe(const cv::Mat& descriptors) const {
 }
 
 void KeyframeDatabase::add(map::KeyFrame* kf) {
-  auto d = std::make_shared<const PlaceDescription>(describe(kf->data().descriptors));
+  add(kf, std::make_shared<const PlaceDescription>(describe(kf->data().descriptors)));
+}
+
+void KeyframeDatabase::add(map::KeyFrame* kf, std::shared_ptr<const PlaceDescription> d) {
   std::lock_guard lock(mutex_);
   if (auto it = entries_.find(kf); it != entries_.end()) {
     unindex_locked(kf, *it->second);

@@ -62,6 +62,10 @@ class KeyframeDatabase {
   // Describes the keyframe's point descriptors and indexes it; a keyframe added twice is
   // re-indexed. Local mapping calls it, off the tracking thread.
   void add(map::KeyFrame* kf);
+  // Indexes a keyframe under a description made earlier (a map file stores them, so loading
+  // does not describe every keyframe again).
+  void add(map::KeyFrame* kf, std::shared_ptr<const PlaceDescription> description);
+  int feature_levels_up() const { return feature_levels_up_; }
   // Forgets a keyframe (culled); unknown keyframes are ignored.
   void erase(const map::KeyFrame* kf);
   // The stored description of a keyframe, null when it is not in the database.

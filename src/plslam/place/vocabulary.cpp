@@ -85,7 +85,14 @@ std::string structure_problem(int k, int levels, const std::vector<Vocabulary::N
 }  // namespace
 
 Vocabulary::Vocabulary(int k, int levels, std::vector<Node> nodes, std::vector<float> word_weights)
-    : k_(k), levels_(levels), nodes_(std::move(nodes)), word_weights_(std::move(word_weights)) {
+    : Vocabulary(k, levels, std::move(nodes), std::move(word_weights), 0) {
+  const std::string body = body_bytes();
+  checksum_ = fnv1a(body.data(), body.size());
+}
+
+Vocabulary::Vocabulary(int k, int levels, std::vector<Node> nodes, std::vector<float> word_weights,
+                       std::uint64_t checksum)
+    : k_(k), levels_(levels), nodes_(std::move(nodes)), word_weights_(std::move(word_weights)), checksum_(checksum) {
   if (const auto problem = structure_problem(k_, levels_, nodes_, word_weights_.size()); !problem.empty()) {
     throw std::invalid_argument("Vocabulary: " + problem);
   }
@@ -181,13 +188,7 @@ BowVector Vocabulary::transform(const std::vector<Descriptor256>& descriptors, F
 }
 
 std::string Vocabulary::to_bytes() const {
-  std::string body;
-  body.reserve(nodes_.size() * kNodeBytes + word_weights_.size() * 4);
-  for (const auto& n : nodes_) body.append(reinterpret_cast<const char*>(n.centre.data()), 32);
-  for (const auto& n : nodes_) put<std::uint32_t>(body, n.first_child);
-  for (const auto& n : nodes_) put<std::uint32_t>(body, n.child_count);
-  for (const auto& n : nodes_) put<std::int32_t>(body, n.word);
-  for (float w : word_weights_) put<float>(body, w);
+  const std::string body = body_bytes();
   std::string out(kMagic, sizeof(kMagic));
   put<std::uint32_t>(out, kVersion);
   put<std::uint32_t>(out, kOrb256);
@@ -197,6 +198,17 @@ std::string Vocabulary::to_bytes() const {
   put<std::uint32_t>(out, static_cast<std::uint32_t>(word_weights_.size()));
   put<std::uint64_t>(out, fnv1a(body.data(), body.size()));
   return out + body;
+}
+
+std::string Vocabulary::body_bytes() const {
+  std::string body;
+  body.reserve(nodes_.size() * kNodeBytes + word_weights_.size() * 4);
+  for (const auto& n : nodes_) body.append(reinterpret_cast<const char*>(n.centre.data()), 32);
+  for (const auto& n : nodes_) put<std::uint32_t>(body, n.first_child);
+  for (const auto& n : nodes_) put<std::uint32_t>(body, n.child_count);
+  for (const auto& n : nodes_) put<std::int32_t>(body, n.word);
+  for (float w : word_weights_) put<float>(body, w);
+  return body;
 }
 
 Vocabulary Vocabulary::from_bytes(const std::string& bytes, const std::string& source) {
@@ -237,7 +249,8 @@ Vocabulary Vocabulary::from_bytes(const std::string& bytes, const std::string& s
   for (auto& w : weights) w = get<float>(p);
   if (k > 256 || levels > 16) throw InputError(source, fmt::format("implausible k = {}, L = {}", k, levels));
   try {
-    return Vocabulary(static_cast<int>(k), static_cast<int>(levels), std::move(nodes), std::move(weights));
+    // The body was checked against the header's checksum above: that is the identity.
+    return Vocabulary(static_cast<int>(k), static_cast<int>(levels), std::move(nodes), std::move(weights), checksum);
   } catch (const std::invalid_argument& e) {
     throw InputError(source, std::string("inconsistent vocabulary: ") + e.what());
   }

@@ -45,6 +45,9 @@ class Vocabulary {
   bool empty() const { return word_weights_.empty(); }
   const std::vector<Node>& nodes() const { return nodes_; }
   float word_weight(std::uint32_t word) const { return word_weights_.at(word); }
+  // The identity of the vocabulary: the FNV-1a 64 checksum of its file body (as in the header).
+  // Map files record it, because word ids mean nothing under another vocabulary.
+  std::uint64_t checksum() const { return checksum_; }
 
   // The word of one descriptor, and the node on its path `levels_up` levels above the leaf's
   // level L (clamped to the root; a leaf higher up is its own node).
@@ -69,6 +72,10 @@ class Vocabulary {
   std::vector<Node> nodes_;
   std::vector<float> word_weights_;
   std::vector<std::uint32_t> word_nodes_;  // node of each word
+  std::uint64_t checksum_ = 0;
+  // The checks of the public constructor, with the body's checksum already known (from_bytes).
+  Vocabulary(int k, int levels, std::vector<Node> nodes, std::vector<float> word_weights, std::uint64_t checksum);
+  std::string body_bytes() const;
 };
 
 }  // namespace plslam::place

@@ -46,7 +46,7 @@ double choose_speed(const Scene& scene, const SequenceOptions& o) {
 Sequence::Sequence(const SequenceOptions& options)
     : options_(options),
       scene_(build_scene(options.scene, options.seed)),
-      path_(scene_, choose_speed(scene_, options), options.seed),
+      path_(scene_, choose_speed(scene_, options), options.seed, options.path_seed),
       sensor_(options.preset.width, options.preset.height, options.seed) {}
 
 StereoCalibration Sequence::calibration() const {
@@ -107,7 +107,8 @@ StereoImages StereoRenderer::render(std::size_t i, bool with_depth) {
   StereoImages out;
   Eigen::Isometry3d T_lr = Eigen::Isometry3d::Identity();
   const double exposure = seq_.sensor().exposure(seq_.time(i));
-  const std::uint64_t base = seq_.options().seed * 0x100000001B3ULL + i * 2;
+  // Another path through the scene gets its own sensor noise too.
+  const std::uint64_t base = (seq_.options().seed ^ (seq_.options().path_seed << 32)) * 0x100000001B3ULL + i * 2;
   render_camera(T_lr, i, radiance_, with_depth ? &out.left_depth : nullptr);
   seq_.sensor().expose(radiance_, exposure, base, out.left);
   T_lr.translation().x() = seq_.options().preset.baseline;

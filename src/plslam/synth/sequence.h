@@ -34,6 +34,8 @@ struct SequenceOptions {
   CameraPreset preset = euroc_preset();
   int frames = 200;
   std::uint64_t seed = 1;
+  // 0: the scene's own path; others: another path through the same scene (PathVariation).
+  std::uint64_t path_seed = 0;
   bool loop = false;         // traverse the whole closed path (>= 30 m) and return to the start
   double loop_overlap = 0.03;  // with loop: share of the path travelled again after the return, in [0, 1]
   bool motion_blur = false;  // integrate over the shutter time, proportional to the motion

@@ -22,8 +22,20 @@ Eigen::Matrix3d camera_rotation(double yaw, double pitch, double roll) {
   return R;
 }
 
-CameraPath::CameraPath(const Scene& scene, double speed, std::uint64_t seed)
-    : speed_(speed), height_(scene.camera_height), vehicle_(scene.vehicle), look_around_(scene.look_around) {
+PathVariation path_variation(std::uint64_t path_seed, bool vehicle) {
+  if (path_seed == 0) return {};
+  Rng rng(path_seed * 0x9E3779B97F4A7C15ULL ^ 0x5EED);
+  PathVariation v;
+  v.start = rng.uniform(0, 1);
+  v.reverse = rng.uniform() < 0.5;
+  v.lateral = rng.uniform(-1, 1) * (vehicle ? 0.5 : 0.25);
+  v.height = rng.uniform(-1, 1) * (vehicle ? 0.05 : 0.1);
+  return v;
+}
+
+CameraPath::CameraPath(const Scene& scene, double speed, std::uint64_t seed, std::uint64_t path_seed)
+    : speed_(speed), height_(scene.camera_height), vehicle_(scene.vehicle), look_around_(scene.look_around),
+      variation_(path_variation(path_seed, scene.vehicle)) {
   const auto& P = scene.path;
   const int n = static_cast<int>(P.size());
   constexpr int kPerSegment = 200;
@@ -43,7 +55,7 @@ CameraPath::CameraPath(const Scene& scene, double speed, std::uint64_t seed)
   cumulative_[0] = 0;
   for (std::size_t i = 1; i < samples_.size(); ++i)
     cumulative_[i] = cumulative_[i - 1] + (samples_[i] - samples_[i - 1]).norm();
-  Rng rng(seed ^ 0x7A11);
+  Rng rng(seed ^ 0x7A11 ^ (path_seed * 0x100000001B3ULL));
   for (double& p : phase_) p = rng.uniform(0, kTwoPi);
 }
 
@@ -64,17 +76,23 @@ double CameraPath::heading(double s, double window) const {
 }
 
 Eigen::Isometry3d CameraPath::pose(double t) const {
-  const double s = speed_ * t;
+  const double direction = variation_.reverse ? -1.0 : 1.0;
+  const double s = variation_.start * length() + direction * speed_ * t;
+  const double travel = variation_.reverse ? std::acos(-1.0) : 0.0;  // heading() follows the loop's own way
   Eigen::Vector2d p = position(s);
+  if (variation_.lateral != 0) {
+    const double h = heading(s, vehicle_ ? 1.5 : 0.4) + travel;
+    p += Eigen::Vector2d(-std::sin(h), std::cos(h)) * variation_.lateral;
+  }
   double yaw, pitch, roll, z;
   if (vehicle_) {
-    yaw = heading(s, 1.5);
+    yaw = heading(s, 1.5) + travel;
     pitch = 0.006 * std::sin(kTwoPi * t / 2.3 + phase_[0]);
     roll = 0.004 * std::sin(kTwoPi * t / 3.1 + phase_[1]);
     z = height_ + 0.01 * std::sin(kTwoPi * t / 1.7 + phase_[2]);
   } else {
     // Walking: lateral sway at the stride rate, bobbing at twice it, slow looking around.
-    const double h = heading(s, 0.4);
+    const double h = heading(s, 0.4) + travel;
     const Eigen::Vector2d lateral(-std::sin(h), std::cos(h));
     p += lateral * (0.03 * std::sin(kTwoPi * 0.9 * t + phase_[0]));
     z = height_ + 0.02 * std::sin(kTwoPi * 1.8 * t + phase_[1]);
@@ -84,7 +102,7 @@ Eigen::Isometry3d CameraPath::pose(double t) const {
   }
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = camera_rotation(yaw, pitch, roll);
-  T.translation() = Eigen::Vector3d(p.x(), p.y(), z);
+  T.translation() = Eigen::Vector3d(p.x(), p.y(), z + variation_.height);
   return T;
 }
 

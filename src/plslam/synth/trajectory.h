@@ -11,10 +11,24 @@
 
 namespace plslam::synth {
 
+// Another walk (or drive) through the same scene, for testing localization on images a map never
+// saw: where on the loop it starts, which way it goes, and a constant sideways and height offset.
+struct PathVariation {
+  double start = 0;      // arc-length offset as a share of the loop, in [0, 1)
+  bool reverse = false;  // travel the loop the other way round
+  double lateral = 0;    // metres to the left of the path (in the direction of travel)
+  double height = 0;     // metres up
+};
+// The variation of `synth --path-seed`: 0 is none (the scene's own path); others draw a start
+// anywhere on the loop, either direction, and offsets of up to +-0.25 m sideways and +-0.1 m in
+// height on foot, +-0.5 m and +-0.05 m in a car (within the scene's clearance either way).
+PathVariation path_variation(std::uint64_t path_seed, bool vehicle);
+
 class CameraPath {
  public:
-  // speed in m/s along the path; the seed sets the phases of the hand-held wobble.
-  CameraPath(const Scene& scene, double speed, std::uint64_t seed);
+  // speed in m/s along the path; the seed sets the phases of the hand-held wobble (mixed with
+  // the path seed when there is one).
+  CameraPath(const Scene& scene, double speed, std::uint64_t seed, std::uint64_t path_seed = 0);
 
   double length() const { return cumulative_.back(); }  // one full loop, metres
   double speed() const { return speed_; }
@@ -32,6 +46,7 @@ class CameraPath {
   bool vehicle_;
   double look_around_;
   double phase_[6];
+  PathVariation variation_;
 };
 
 // Rotation camera -> world for yaw (about world z, 0 = looking along +x), pitch (up positive)

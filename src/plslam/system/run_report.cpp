@@ -160,6 +160,27 @@ nlohmann::json evaluate_against_ground_truth(const io::Dataset& dataset, const T
   return j;
 }
 
+std::optional<geometry::SE3> ground_truth_anchor(const io::Dataset& dataset, const map::KeyFrame& first) {
+  if (!dataset.ground_truth() || dataset.ground_truth()->empty()) return std::nullopt;
+  const auto& gt = *dataset.ground_truth();
+  const auto it = std::min_element(gt.begin(), gt.end(), [&](const StampedPose& a, const StampedPose& b) {
+    return std::abs(a.t - first.timestamp()) < std::abs(b.t - first.timestamp());
+  });
+  if (std::abs(it->t - first.timestamp()) > 0.01) return std::nullopt;
+  return geometry::SE3(it->T) * first.pose();
+}
+
+nlohmann::json evaluate_in_map_frame(const io::Dataset& dataset, const Trajectory& estimate,
+                                     const geometry::SE3& T_gt_map) {
+  Trajectory in_gt = estimate;
+  for (auto& p : in_gt) p.T = T_gt_map.isometry() * p.T;
+  eval::EvalOptions o;
+  o.align = eval::AlignMode::kNone;
+  auto j = eval::to_json(eval::evaluate(*dataset.ground_truth(), in_gt, o));
+  j["ground_truth"] = dataset.ground_truth_path().string();
+  return j;
+}
+
 std::string format_accuracy(const nlohmann::json& a) {
   return fmt::format("ATE (se3) rmse {:.4f} m over {} poses; RPE (1 frame) rmse {:.4f} m, {:.3f} deg\n",
                      a["ape_trans_m"]["rmse"].get<double>(), a["pairs"].get<std::size_t>(),

@@ -1,6 +1,7 @@
 #pragma once
 // What `plslam run` reports: per-frame timings and counts gathered during the run, turned into
 // stats.json and a short summary; and the accuracy against the dataset's ground truth.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,5 +38,13 @@ struct RunReport {
 // through the eval library.
 nlohmann::json evaluate_against_ground_truth(const io::Dataset& dataset, const Trajectory& estimate);
 std::string format_accuracy(const nlohmann::json& accuracy);
+
+// The map's world in the ground truth's world (MapFileMeta::T_gt_map): the ground-truth pose at
+// the first keyframe's time composed with that keyframe's pose; nullopt without ground truth there.
+std::optional<geometry::SE3> ground_truth_anchor(const io::Dataset& dataset, const map::KeyFrame& first);
+// Position errors of a trajectory expressed in a loaded map's world, taken into the ground
+// truth's world by `T_gt_map` and compared with NO alignment: {pairs, ape_trans_m, ...}.
+nlohmann::json evaluate_in_map_frame(const io::Dataset& dataset, const Trajectory& estimate,
+                                     const geometry::SE3& T_gt_map);
 
 }  // namespace plslam::system

@@ -3,6 +3,7 @@
 #include "plslam/core/stopwatch.h"
 
 #include <algorithm>
+#include <stdexcept>
 #include <chrono>
 
 namespace plslam::system {
@@ -38,7 +39,9 @@ void SystemOptions::disable_lines() {
 }
 
 System::System(const StereoCalibration& calib, SystemOptions options, std::shared_ptr<const place::Vocabulary> vocabulary)
-    : options_(std::move(options)), extractor_(calib, options_.extractor) {
+    : options_(std::move(options)), extractor_(calib, options_.extractor), calib_(calib) {
+  options_.tracker.localization_only = options_.localization_only;
+  if (options_.localization_only) options_.loop_closing = false;
   options_.mapper.line_information = options_.tracker.line_information;
   options_.mapper.far_stereo_baselines = options_.tracker.far_stereo_baselines;
   options_.tracker.seed = options_.seed;
@@ -60,7 +63,7 @@ System::System(const StereoCalibration& calib, SystemOptions options, std::share
       map_, options_.tracker, [mapper](map::KeyFrame* kf) { mapper->insert(kf); },
       [mapper, sequential] { return sequential || mapper->idle(); });
   tracker_->set_keyframe_database(database_.get());
-  if (!sequential) {
+  if (!sequential && !options_.localization_only) {
     mapper_->start();
     if (loop_closer_) loop_closer_->start();
   }
@@ -94,6 +97,27 @@ void System::finish() {
     loop_closer_->finish();
     loop_closer_->stop();
   }
+}
+
+void System::load_map(const MapContents& contents) {
+  if (!tracker_->records().empty() || map_.first_keyframe()) {
+    throw std::logic_error("System::load_map: the system already has a map");
+  }
+  {
+    std::lock_guard lock(map_.update_mutex());
+    restore_map(contents, map_, database_.get());
+  }
+  tracker_->start_in_loaded_map();
+}
+
+MapContents System::capture_map(MapFileMeta meta) const {
+  meta.calib = calib_;
+  if (database_) {
+    meta.vocabulary_checksum = database_->vocabulary().checksum();
+    meta.vocabulary_words = static_cast<std::uint32_t>(database_->vocabulary().size());
+    meta.vocabulary_nodes = static_cast<std::uint32_t>(database_->vocabulary().nodes().size());
+  }
+  return system::capture_map(map_, database_.get(), std::move(meta));
 }
 
 Trajectory System::tracked_trajectory() const {

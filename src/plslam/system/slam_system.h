@@ -13,6 +13,7 @@
 #include "plslam/loop/loop_closer.h"
 #include "plslam/mapping/local_mapper.h"
 #include "plslam/place/keyframe_database.h"
+#include "plslam/system/map_file.h"
 #include "plslam/tracking/frame_extractor.h"
 #include "plslam/tracking/tracker.h"
 
@@ -33,6 +34,9 @@ struct SystemOptions {
   // Loop closing (config `loop`, --no-loop-closing): needs place recognition.
   bool loop_closing = true;
   loop::LoopClosingOptions loop;
+  // Localization in a loaded map (--localize): no keyframes, points or lines are added, and
+  // neither local mapping nor loop closing runs.
+  bool localization_only = false;
 
   static SystemOptions euroc();
   static SystemOptions kitti();
@@ -61,6 +65,13 @@ class System {
   // Lets local mapping finish its queue and stops it. Outputs are final after this.
   void finish();
 
+  // Before the first frame: takes the map of a map file (check_map_matches first); the first
+  // frame is then relocalized in it. Throws std::logic_error after the first frame.
+  void load_map(const MapContents& contents);
+  // The map as a map file holds it (after finish()); meta's calibration and vocabulary identity
+  // are filled in here.
+  MapContents capture_map(MapFileMeta meta) const;
+
   // The tracked frames only (never a prediction made while lost or before initialisation),
   // T_world_leftcam with world = the first keyframe's camera.
   Trajectory tracked_trajectory() const;
@@ -84,6 +95,7 @@ class System {
   std::unique_ptr<mapping::LocalMapper> mapper_;
   std::unique_ptr<loop::LoopCloser> loop_closer_;
   std::unique_ptr<tracking::Tracker> tracker_;
+  StereoCalibration calib_;
   bool finished_ = false;
 };
 

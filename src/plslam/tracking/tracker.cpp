@@ -2,6 +2,7 @@
 
 #include "plslam/core/stopwatch.h"
 
+#include <stdexcept>
 #include <algorithm>
 #include <chrono>
 #include <map>
@@ -36,6 +37,11 @@ Tracker::Tracker(map::Map& map, TrackerOptions options, std::function<void(map::
       insert_keyframe_(std::move(insert_keyframe)),
       mapping_idle_(std::move(mapping_idle)),
       policy_(options_.keyframe) {}
+
+void Tracker::start_in_loaded_map() {
+  if (!records_.empty()) throw std::logic_error("Tracker::start_in_loaded_map after the first frame");
+  state_ = TrackingState::kLost;
+}
 
 double Tracker::close_depth(const Frame& f) const {
   return options_.close_depth_baselines * f.data->calib.baseline;
@@ -168,7 +174,7 @@ void Tracker::finish_tracked_frame(Frame& f, TrackResult& result) {
   result.local_keyframes = static_cast<int>(local_keyframes_.size());
   result.local_points = static_cast<int>(local_points_.size());
   result.local_lines = static_cast<int>(local_lines_.size());
-  if (result.decision.insert) {
+  if (result.decision.insert && !options_.localization_only) {
     create_keyframe(f);
     policy_.keyframe_inserted(inputs);
     result.keyframe = true;
@@ -183,6 +189,7 @@ bool Tracker::can_start_map(const Frame& f) const {
 }
 
 bool Tracker::should_start_new_segment(const Frame& f) {
+  if (options_.localization_only) return false;
   if (!relocalization_on()) return true;
   if (!can_start_map(f)) return false;  // could not start one anyway
   if (!lost_since_) lost_since_ = f.data->timestamp;

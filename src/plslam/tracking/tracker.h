@@ -62,6 +62,9 @@ struct TrackerOptions {
   int local_keyframes_max = 80;
   RelocalizationOptions relocalization;
   std::uint32_t seed = 1;  // of the relocalization's PnP RANSAC (SystemOptions::seed)
+  // Localization in a loaded map: no keyframe is created and a lost camera never starts a new
+  // map segment; it waits for relocalization instead.
+  bool localization_only = false;
 };
 
 enum class TrackingState { kNotInitialized, kOk, kLost };
@@ -109,6 +112,9 @@ class Tracker {
   // Place recognition for relocalization; without one, a lost camera starts a new map segment on
   // the next frame that can. Not owned; must outlive the tracker.
   void set_keyframe_database(const place::KeyframeDatabase* database) { database_ = database; }
+  // The map was loaded from a file: the first frame is relocalized in it instead of starting a
+  // map (call before the first frame).
+  void start_in_loaded_map();
 
   TrackingState state() const { return state_; }
   int lost_events() const { return lost_events_; }

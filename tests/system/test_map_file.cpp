@@ -1,0 +1,318 @@
+// Map reuse: the .plmap file (round trip, corrupt and mismatched files) and `plslam run
+// --save-map / --load-map [--localize]`, `plslam map info / export`, on a short rendered office
+// sequence mapped once per suite.
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <random>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "plslam/core/error.h"
+#include "plslam/io/dataset.h"
+#include "plslam/system/map_file.h"
+#include "plslam/system/slam_system.h"
+#include "plslam/system/system_config.h"
+#include "support/test_support.h"
+
+namespace plslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kFrames = 40;
+
+class MapReuse : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    tmp_ = std::make_unique<test::TempDir>();
+    auto r = test::run_cli("synth --out \"" + sequence().string() + "\" --scene office --preset euroc --frames " +
+                           std::to_string(kFrames) + " --seed 3 --threads 2");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = test::run_cli("run \"" + sequence().string() + "\" --out \"" + (tmp_->path() / "mapping").string() +
+                      "\" --quiet --sequential --save-map \"" + map_file().string() + "\"");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  static void TearDownTestSuite() { tmp_.reset(); }
+  static fs::path sequence() { return tmp_->path() / "office"; }
+  static fs::path map_file() { return tmp_->path() / "office.plmap"; }
+  static std::string map_bytes() { return test::read_file(map_file()); }
+
+  // A copy of the map with `edit` applied to its contents, saved under `name`.
+  static fs::path edited_map(const std::string& name, const std::function<void(system::MapContents&)>& edit) {
+    auto c = system::load_map_file(map_file());
+    edit(c);
+    const fs::path p = tmp_->path() / name;
+    system::save_map_file(p, c);
+    return p;
+  }
+  static fs::path written(const std::string& name, const std::string& bytes) {
+    const fs::path p = tmp_->path() / name;
+    std::ofstream(p, std::ios::binary) << bytes;
+    return p;
+  }
+  static test::CliResult localize(const fs::path& map, const fs::path& out, const std::string& extra = "") {
+    return test::run_cli("run \"" + sequence().string() + "\" --out \"" + out.string() + "\" --quiet --load-map \"" +
+                         map.string() + "\"" + extra);
+  }
+
+  static std::unique_ptr<test::TempDir> tmp_;
+};
+
+std::unique_ptr<test::TempDir> MapReuse::tmp_;
+
+std::unique_ptr<system::System> make_system(const io::Dataset& ds, bool localization_only = false) {
+  auto options = system::load_system_options(ds.format(), std::nullopt);
+  options.sequential = true;
+  options.localization_only = localization_only;
+  return std::make_unique<system::System>(ds.calibration(), options, system::load_vocabulary(options));
+}
+
+TEST_F(MapReuse, SaveLoadSaveIsByteIdentical) {
+  const std::string bytes = map_bytes();
+  const auto contents = system::map_from_bytes(bytes, "office.plmap");
+  EXPECT_GE(contents.keyframes.size(), 3u);
+  EXPECT_GT(contents.points.size(), 500u);
+  EXPECT_GT(contents.lines.size(), 50u);
+  const auto ds = io::open_dataset(sequence(), {});
+  auto slam = make_system(*ds);
+  slam->load_map(contents);
+  EXPECT_EQ(slam->map().num_keyframes(), contents.keyframes.size());
+  EXPECT_EQ(slam->map().num_points(), contents.points.size());
+  EXPECT_EQ(slam->map().num_lines(), contents.lines.size());
+  ASSERT_NE(slam->keyframe_database(), nullptr);
+  EXPECT_EQ(slam->keyframe_database()->size(), contents.keyframes.size());
+  auto meta = contents.meta;
+  const auto again = system::map_to_bytes(slam->capture_map(meta));
+  ASSERT_EQ(again.size(), bytes.size());
+  EXPECT_TRUE(again == bytes);
+}
+
+TEST_F(MapReuse, RestoredObjectsAreTheSavedOnes) {
+  const auto contents = system::load_map_file(map_file());
+  map::Map map;
+  system::restore_map(contents, map, nullptr);
+  const auto kfs = map.keyframes();
+  ASSERT_EQ(kfs.size(), contents.keyframes.size());
+  for (std::size_t i = 0; i < kfs.size(); ++i) {
+    const auto& saved = contents.keyframes[i];
+    EXPECT_EQ(kfs[i]->id(), saved.id);
+    EXPECT_TRUE(kfs[i]->pose().matrix() == saved.T_cw.matrix());
+    EXPECT_EQ(kfs[i]->data().keypoints.size(), saved.data->keypoints.size());
+    EXPECT_FALSE(kfs[i]->data().grid.empty());
+    for (const auto& [id, w] : saved.covisibility) {
+      const auto it = std::find_if(kfs.begin(), kfs.end(), [id = id](auto* k) { return k->id() == id; });
+      ASSERT_NE(it, kfs.end());
+      EXPECT_EQ(kfs[i]->weight(*it), w);
+    }
+    if (saved.parent >= 0) {
+      ASSERT_NE(kfs[i]->parent(), nullptr);
+      EXPECT_EQ(kfs[i]->parent()->id(), saved.parent);
+    }
+  }
+  const auto points = map.points();
+  ASSERT_EQ(points.size(), contents.points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto& saved = contents.points[i];
+    EXPECT_EQ(points[i]->id(), saved.id);
+    EXPECT_EQ(points[i]->position(), saved.a);
+    EXPECT_EQ(static_cast<std::size_t>(points[i]->num_observations()), saved.observations.size());
+    for (const auto& [kf, idx] : points[i]->observations()) EXPECT_EQ(kf->map_point(idx), points[i]);
+  }
+  // New objects never reuse a saved id.
+  auto* p = map.create_point(Eigen::Vector3d::Zero(), kfs.front(), 0);
+  EXPECT_GE(p->id(), contents.meta.next_ids.point);
+}
+
+TEST_F(MapReuse, EveryFlippedByteIsCaught) {
+  const std::string bytes = map_bytes();
+  std::mt19937_64 rng(7);
+  for (int i = 0; i < 300; ++i) {
+    std::string b = bytes;
+    const std::size_t at = rng() % b.size();
+    b[at] = static_cast<char>(b[at] ^ static_cast<char>(1 + rng() % 255));
+    EXPECT_THROW(system::map_from_bytes(b, "flipped.plmap"), InputError) << "byte " << at;
+  }
+}
+
+// Behind the checksums: random bytes flipped in a file whose checksums are not verified give a
+// clean error or a map that restores, never a crash (the sanitizer stages watch this one).
+TEST_F(MapReuse, FlippedBytesBehindTheChecksumsNeverCrash) {
+  const std::string bytes = map_bytes();
+  std::mt19937_64 rng(11);
+  int rejected = 0, accepted = 0;
+  system::MapReadOptions unchecked;
+  unchecked.verify_checksums = false;
+  for (int i = 0; i < 300; ++i) {
+    std::string b = bytes;
+    const int flips = 1 + static_cast<int>(rng() % 4);
+    for (int f = 0; f < flips; ++f) {
+      // Half the flips land in the first 64 KB (headers, meta, the first keyframe's counts).
+      const std::size_t at = (i % 2 ? rng() % std::min<std::size_t>(b.size(), 65536) : rng() % b.size());
+      b[at] = static_cast<char>(b[at] ^ static_cast<char>(1 << (rng() % 8)));
+    }
+    try {
+      const auto c = system::map_from_bytes(b, "flipped.plmap", unchecked);
+      map::Map map;
+      system::restore_map(c, map, nullptr);
+      ++accepted;
+    } catch (const InputError&) {
+      ++rejected;
+    }
+  }
+  EXPECT_GT(rejected, 0);
+  EXPECT_GT(accepted, 0);  // most flips in float payloads leave a valid map
+}
+
+TEST_F(MapReuse, TruncatedAndForeignFilesAreRejected) {
+  const std::string bytes = map_bytes();
+  for (std::size_t keep : {std::size_t{0}, std::size_t{7}, std::size_t{16}, std::size_t{40}, bytes.size() / 2,
+                           bytes.size() - 1}) {
+    try {
+      system::map_from_bytes(bytes.substr(0, keep), "cut.plmap");
+      ADD_FAILURE() << "accepted a file cut to " << keep << " bytes";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+      EXPECT_EQ(e.file(), "cut.plmap");
+    }
+  }
+  EXPECT_THROW(system::map_from_bytes(bytes + "x", "long.plmap"), InputError);
+  EXPECT_THROW(system::map_from_bytes("plsvocab and more bytes here", "voc.plmap"), InputError);
+}
+
+TEST_F(MapReuse, BadMapFilesGetOneLineErrorsAndExit2) {
+  const std::string bytes = map_bytes();
+  std::string wrong_version = bytes;
+  wrong_version[8] = 9;
+  std::string corrupt = bytes;
+  corrupt[bytes.size() / 2] = static_cast<char>(corrupt[bytes.size() / 2] ^ 0x10);
+  const std::vector<std::pair<fs::path, std::string>> cases = {
+      {written("cut.plmap", bytes.substr(0, bytes.size() / 3)), "truncated"},
+      {written("corrupt.plmap", corrupt), "checksum mismatch"},
+      {written("version.plmap", wrong_version), "version 9"},
+      {written("foreign.plmap", "just some text\n"), "not a plslam map"},
+      {tmp_->path() / "missing.plmap", "not found"},
+      {edited_map("vocab.plmap", [](auto& c) { c.meta.vocabulary_checksum ^= 1; }), "vocabulary"},
+      {edited_map("baseline.plmap", [](auto& c) { c.meta.calib.baseline *= 2; }), "baseline"},
+      {edited_map("size.plmap", [](auto& c) { c.meta.calib.width = 640; }), "640x480"},
+      {edited_map("fx.plmap", [](auto& c) { c.meta.calib.fx *= 1.01; }), "intrinsics"},
+  };
+  for (const auto& [file, expected] : cases) {
+    test::TempDir out;
+    const auto r = localize(file, out.path() / "run", " --localize");
+    EXPECT_EQ(r.exit_code, 2) << file << ": " << r.err;
+    EXPECT_NE(r.err.find(file.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out.path() / "run" / "stats.json")) << file;
+  }
+  // Usage: --localize needs a map; no place recognition cannot find the camera in one.
+  test::TempDir out;
+  EXPECT_EQ(test::run_cli("run \"" + sequence().string() + "\" --out \"" + out.path().string() + "\" --localize")
+                .exit_code,
+            2);
+  const auto r = localize(map_file(), out.path() / "np", " --no-place-recognition");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("place recognition"), std::string::npos) << r.err;
+}
+
+TEST_F(MapReuse, UnwritableSaveMapFailsBeforeAnyFrame) {
+  test::TempDir out;
+  const fs::path a_file = out.path() / "a_file";
+  std::ofstream(a_file) << "x";
+  for (const fs::path& target : {a_file / "map.plmap", out.path()}) {
+    const auto r = test::run_cli("run \"" + sequence().string() + "\" --out \"" + (out.path() / "run").string() +
+                                 "\" --quiet --save-map \"" + target.string() + "\"");
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(target.string()), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out.path() / "run" / "stats.json"));
+  }
+  // A failing write leaves no file under the final name (PLSLAM_FAIL_WRITE stands in for a full disk).
+  const fs::path map = out.path() / "full.plmap";
+  ::setenv("PLSLAM_FAIL_WRITE", "full.plmap", 1);
+  const auto r = test::run_cli("run \"" + sequence().string() + "\" --out \"" + (out.path() / "run2").string() +
+                               "\" --quiet --max-frames 5 --save-map \"" + map.string() + "\"");
+  ::unsetenv("PLSLAM_FAIL_WRITE");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("full.plmap"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(map));
+  for (const auto& e : fs::directory_iterator(out.path())) {
+    EXPECT_EQ(e.path().filename().string().find("full.plmap"), std::string::npos) << e.path();
+  }
+}
+
+TEST_F(MapReuse, LocalizationOnlyTracksEveryFrameInTheMapFrameAndAddsNothing) {
+  test::TempDir out;
+  const auto r = localize(map_file(), out.path() / "loc", " --localize --save-map \"" +
+                                                              (out.path() / "after.plmap").string() + "\"");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto stats = nlohmann::json::parse(test::read_file(out.path() / "loc" / "stats.json"));
+  const auto contents = system::load_map_file(map_file());
+  EXPECT_EQ(stats["tracked_frames"], kFrames);
+  EXPECT_EQ(stats["keyframes"], contents.keyframes.size());
+  EXPECT_EQ(stats["map"]["localization_only"], true);
+  // The map's world is the mapping run's: positions agree with the ground truth through the
+  // anchor saved with the map, with no alignment.
+  ASSERT_TRUE(stats.contains("accuracy_in_map_frame")) << stats.dump();
+  EXPECT_LT(stats["accuracy_in_map_frame"]["ape_trans_m"]["rmse"].get<double>(), 0.03);
+  const auto after = system::load_map_file(out.path() / "after.plmap");
+  EXPECT_EQ(after.keyframes.size(), contents.keyframes.size());
+  EXPECT_EQ(after.points.size(), contents.points.size());
+  EXPECT_EQ(after.lines.size(), contents.lines.size());
+}
+
+TEST_F(MapReuse, MappingContinuesOnALoadedMap) {
+  test::TempDir out;
+  const fs::path first = out.path() / "first.plmap", both = out.path() / "both.plmap";
+  auto r = test::run_cli("run \"" + sequence().string() + "\" --out \"" + (out.path() / "a").string() +
+                         "\" --quiet --sequential --max-frames 20 --save-map \"" + first.string() + "\"");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = test::run_cli("run \"" + sequence().string() + "\" --out \"" + (out.path() / "b").string() +
+                    "\" --quiet --sequential --start 18 --load-map \"" + first.string() + "\" --save-map \"" +
+                    both.string() + "\"");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto stats = nlohmann::json::parse(test::read_file(out.path() / "b" / "stats.json"));
+  EXPECT_EQ(stats["tracked_frames"], kFrames - 18);
+  EXPECT_EQ(stats["new_map_segments"]["count"], 0);
+  EXPECT_EQ(stats["relocalizations"]["count"], 1) << stats["relocalizations"].dump();
+  const auto a = system::load_map_file(first), b = system::load_map_file(both);
+  EXPECT_GT(b.keyframes.size(), a.keyframes.size());
+  EXPECT_GT(b.points.size(), a.points.size());
+  // The loaded keyframes keep their ids; the new ones continue after them.
+  EXPECT_EQ(b.keyframes.front().id, a.keyframes.front().id);
+  EXPECT_GE(b.keyframes.back().id, a.meta.next_ids.keyframe);
+  ASSERT_TRUE(stats.contains("accuracy_in_map_frame")) << stats.dump();
+  EXPECT_LT(stats["accuracy_in_map_frame"]["ape_trans_m"]["rmse"].get<double>(), 0.05);
+}
+
+TEST_F(MapReuse, InfoAndExport) {
+  auto r = test::run_cli("map info \"" + map_file().string() + "\" --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const auto contents = system::load_map_file(map_file());
+  EXPECT_EQ(j["keyframes"], contents.keyframes.size());
+  EXPECT_EQ(j["points"], contents.points.size());
+  EXPECT_EQ(j["lines"], contents.lines.size());
+  EXPECT_EQ(j["calibration"]["width"], 752);
+  EXPECT_FALSE(j["vocabulary"].is_null());
+  EXPECT_EQ(j["ground_truth_anchor"], true);
+  EXPECT_NE(j["config"].get<std::string>().find("euroc"), std::string::npos);
+  test::TempDir out;
+  r = test::run_cli("map export \"" + map_file().string() + "\" --out \"" + out.path().string() + "\"");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(test::read_file(out.path() / "map_points.ply").find(fmt::format("element vertex {}", contents.points.size())),
+            std::string::npos);
+  EXPECT_TRUE(fs::exists(out.path() / "map_lines.ply"));
+  std::ifstream tum(out.path() / "keyframes.tum");
+  std::size_t rows = 0;
+  for (std::string line; std::getline(tum, line);) rows += !line.empty() && line[0] != '#';
+  EXPECT_EQ(rows, contents.keyframes.size());
+  r = test::run_cli("map info \"" + (tmp_->path() / "nothing.plmap").string() + "\"");
+  EXPECT_EQ(r.exit_code, 2);
+}
+
+}  // namespace
+}  // namespace plslam
