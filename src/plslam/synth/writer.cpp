@@ -110,6 +110,16 @@ void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const E
                       {"fx", o.preset.fx}, {"fy", o.preset.fy}, {"cx", o.preset.cx}, {"cy", o.preset.cy},
                       {"baseline_m", o.preset.baseline}, {"path_length_m", seq.path().length()},
                       {"speed_mps", seq.path().speed()}, {"frame", frame_name}};
+  j["path_seed"] = o.path_seed;
+  // The scene's world from the ground truth's frame (row-major 4x4): KITTI's ground truth starts
+  // at each sequence's first camera, so runs on two paths through one scene (a saved map, then
+  // localization) are compared in this common world.
+  const Eigen::Matrix4d W = T_out_world.inverse().matrix();
+  std::vector<double> rows;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) rows.push_back(W(r, c));
+  }
+  j["world_from_ground_truth"] = rows;
   open_out(dir / "synth.json") << j.dump(2) << "\n";
 }
 

@@ -47,9 +47,10 @@ struct MapFileMeta {
   std::uint32_t vocabulary_words = 0;
   std::uint32_t vocabulary_nodes = 0;
   map::Map::NextIds next_ids;
-  // Where the map's world sits in the ground truth's world, from the ground-truth pose of the
-  // first keyframe when the mapping dataset had one: a later run in the same ground-truth world
-  // (another path through a rendered scene) is then scored with no alignment at all.
+  // Where the map's world sits in the ground truth's world (for a rendered sequence, its scene's
+  // world), from the ground-truth pose of the first keyframe when the mapping dataset had one: a
+  // later run in the same world (another path through a rendered scene) is then scored with no
+  // alignment at all.
   std::optional<geometry::SE3> T_gt_map;
   std::string created_by;  // plslam version and the dataset
   std::string config;      // the configuration that built the map (YAML)

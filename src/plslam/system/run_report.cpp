@@ -3,10 +3,13 @@
 #include "plslam/core/sample_stats.h"
 
 #include <algorithm>
+#include <cmath>
+#include <fstream>
 #include <numeric>
 
 #include <fmt/format.h>
 
+#include "plslam/core/error.h"
 #include "plslam/eval/evaluate.h"
 
 namespace plslam::system {
@@ -160,6 +163,32 @@ nlohmann::json evaluate_against_ground_truth(const io::Dataset& dataset, const T
   return j;
 }
 
+geometry::SE3 shared_world_from_ground_truth(const io::Dataset& dataset) {
+  const auto file = dataset.root() / "synth" / "synth.json";
+  std::ifstream in(file);
+  if (!in) return {};
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(file.string(), std::string("not JSON: ") + e.what());
+  }
+  if (!j.contains("world_from_ground_truth")) return {};  // rendered before it was recorded
+  const auto& v = j["world_from_ground_truth"];
+  if (!v.is_array() || v.size() != 16) throw InputError(file.string(), "world_from_ground_truth: expected 16 numbers");
+  Eigen::Matrix4d M;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      const auto& x = v[static_cast<std::size_t>(r * 4 + c)];
+      if (!x.is_number() || !std::isfinite(x.get<double>())) {
+        throw InputError(file.string(), "world_from_ground_truth: not a finite number");
+      }
+      M(r, c) = x.get<double>();
+    }
+  }
+  return geometry::SE3::from_matrix(M);
+}
+
 std::optional<geometry::SE3> ground_truth_anchor(const io::Dataset& dataset, const map::KeyFrame& first) {
   if (!dataset.ground_truth() || dataset.ground_truth()->empty()) return std::nullopt;
   const auto& gt = *dataset.ground_truth();
@@ -167,13 +196,14 @@ std::optional<geometry::SE3> ground_truth_anchor(const io::Dataset& dataset, con
     return std::abs(a.t - first.timestamp()) < std::abs(b.t - first.timestamp());
   });
   if (std::abs(it->t - first.timestamp()) > 0.01) return std::nullopt;
-  return geometry::SE3(it->T) * first.pose();
+  return shared_world_from_ground_truth(dataset) * geometry::SE3(it->T) * first.pose();
 }
 
 nlohmann::json evaluate_in_map_frame(const io::Dataset& dataset, const Trajectory& estimate,
-                                     const geometry::SE3& T_gt_map) {
+                                     const geometry::SE3& T_shared_map) {
+  const Eigen::Isometry3d T_gt_map = (shared_world_from_ground_truth(dataset).inverse() * T_shared_map).isometry();
   Trajectory in_gt = estimate;
-  for (auto& p : in_gt) p.T = T_gt_map.isometry() * p.T;
+  for (auto& p : in_gt) p.T = T_gt_map * p.T;
   eval::EvalOptions o;
   o.align = eval::AlignMode::kNone;
   auto j = eval::to_json(eval::evaluate(*dataset.ground_truth(), in_gt, o));

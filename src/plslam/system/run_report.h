@@ -39,11 +39,16 @@ struct RunReport {
 nlohmann::json evaluate_against_ground_truth(const io::Dataset& dataset, const Trajectory& estimate);
 std::string format_accuracy(const nlohmann::json& accuracy);
 
-// The map's world in the ground truth's world (MapFileMeta::T_gt_map): the ground-truth pose at
-// the first keyframe's time composed with that keyframe's pose; nullopt without ground truth there.
+// The frame that ground truths of different sequences share, from the dataset's ground-truth
+// frame: a rendered sequence records its scene's world (synth/synth.json,
+// "world_from_ground_truth"; KITTI's ground truth starts at each sequence's first camera);
+// identity for any other dataset, whose ground truth is taken to be its own world.
+geometry::SE3 shared_world_from_ground_truth(const io::Dataset& dataset);
+// The map's world in that shared frame (MapFileMeta::T_gt_map): the ground-truth pose at the
+// first keyframe's time composed with that keyframe's pose; nullopt without ground truth there.
 std::optional<geometry::SE3> ground_truth_anchor(const io::Dataset& dataset, const map::KeyFrame& first);
-// Position errors of a trajectory expressed in a loaded map's world, taken into the ground
-// truth's world by `T_gt_map` and compared with NO alignment: {pairs, ape_trans_m, ...}.
+// Position errors of a trajectory expressed in a loaded map's world, taken into this dataset's
+// ground-truth frame through the anchor and compared with NO alignment: {pairs, ape_trans_m, ...}.
 nlohmann::json evaluate_in_map_frame(const io::Dataset& dataset, const Trajectory& estimate,
                                      const geometry::SE3& T_gt_map);
 

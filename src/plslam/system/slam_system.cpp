@@ -16,6 +16,10 @@ SystemOptions SystemOptions::euroc() {
   // keyframe at 85 % of the reference's tracked features instead of 75 % took 80 -> 120 keyframes
   // (ORB-SLAM3: 177) and the median ATE from 0.019-0.025 to 0.016-0.019 m.
   o.tracker.keyframe.ratio = 0.85;
+  // Walkers and EuRoC's MAV stay below ~2.5 m/s: a relocalization further than 4 m/s from the
+  // last tracked pose is a look-alike place (the rendered office repeats its windows and desks
+  // every 5 m, and localization on another path through it jumped 10 m without this gate).
+  o.tracker.relocalization.max_speed = 4.0;
   return o;
 }
 
@@ -29,6 +33,7 @@ SystemOptions SystemOptions::kitti() {
   // far points' stereo depths stretch the trajectory by 0.4-0.6 % (06) and 4-7 % (01, highway);
   // beyond 20 baselines (10.7 m, 35 px disparity) matches only seed depths (tracking.far_stereo_baselines).
   o.tracker.far_stereo_baselines = 20;
+  o.tracker.relocalization.max_speed = 40.0;  // 144 km/h
   return o;
 }
 

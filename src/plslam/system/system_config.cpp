@@ -45,6 +45,8 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
   if (!(o.tracker.motion_retry_scale >= 1))
     throw InputError(config.source(), "tracking.motion_retry_scale: must be >= 1");
   tracking.get("min_local_inliers", o.tracker.min_local_inliers);
+  tracking.get("local_keyframes_max", o.tracker.local_keyframes_max);
+  if (o.tracker.local_keyframes_max < 1) throw InputError(config.source(), "tracking.local_keyframes_max: must be >= 1");
 
   const auto kf = config.section("keyframe");
   auto& k = o.tracker.keyframe;
@@ -94,6 +96,10 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
   if (r.min_inliers < 1) throw InputError(config.source(), "relocalization.min_inliers: must be >= 1");
   reloc.get("search_radius", r.search_radius);
   if (!(r.search_radius > 0)) throw InputError(config.source(), "relocalization.search_radius: must be positive");
+  reloc.get("max_speed", r.max_speed);
+  if (!(r.max_speed >= 0)) throw InputError(config.source(), "relocalization.max_speed: must be >= 0");
+  reloc.get("gate_margin", r.gate_margin);
+  if (!(r.gate_margin >= 0)) throw InputError(config.source(), "relocalization.gate_margin: must be >= 0");
   reloc.get("new_segment_after_s", r.new_segment_after_s);
   if (!(r.new_segment_after_s >= 0)) throw InputError(config.source(), "relocalization.new_segment_after_s: must be >= 0");
 

@@ -142,6 +142,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   rec.T_cr = f.reference ? f.T_cw * f.reference->pose_inverse() : f.T_cw;
   rec.tracked = ok;
   records_.push_back(rec);
+  if (ok) last_tracked_record_ = records_.size() - 1;
   result.state = state_;
   result.tracked = ok;
   last_ = std::move(f);

@@ -35,6 +35,12 @@ struct RelocalizationOptions {
   // A camera that stays lost this long on frames that could start a map (seconds of textured
   // frames, so a black-out does not count) starts a new map segment instead.
   double new_segment_after_s = 1.0;
+  // A camera cannot have moved further than max_speed times the time since it was last tracked,
+  // plus gate_margin metres: a pose beyond that is another place that looks the same (a row of
+  // identical windows, desks or shelves) and the next candidate is tried. 0: no gate. Before the
+  // first tracked frame (a loaded map) there is no gate: the camera may be anywhere.
+  double max_speed = 0;     // m/s
+  double gate_margin = 1.0; // m
 };
 
 struct TrackerOptions {
@@ -173,6 +179,7 @@ class Tracker {
   std::vector<map::MapPoint*> local_points_;
   std::vector<map::MapLine*> local_lines_;
   std::vector<FrameRecord> records_;
+  std::optional<std::size_t> last_tracked_record_;  // index into records_
   long seen_big_changes_ = 0;  // map_.big_changes() when the last frame was tracked
   int lost_events_ = 0;
   const place::KeyframeDatabase* database_ = nullptr;

@@ -1,5 +1,9 @@
 // Tracker::relocalize: finding the camera again in the map it was lost in.
+#include <algorithm>
+#include <optional>
 #include <unordered_set>
+
+#include <spdlog/spdlog.h>
 
 #include "plslam/core/stopwatch.h"
 #include "plslam/geometry/pnp.h"
@@ -22,7 +26,17 @@ bool Tracker::relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id) {
   const auto candidates = database_->query(place.bow, q);
   const place::BowImage query{&f.data->descriptors, &place.features, &f.data->keypoints};
   const geometry::StereoCamera cam(f.data->calib);
-  bool found = false;
+  // The motion gate (RelocalizationOptions::max_speed): where the camera can be by now.
+  std::optional<Eigen::Vector3d> last_centre;
+  double reach = 0;
+  if (o.max_speed > 0 && last_tracked_record_) {
+    const FrameRecord& rec = records_[*last_tracked_record_];
+    last_centre = pose_of(rec).inverse().translation();
+    reach = o.max_speed * std::max(0.0, f.data->timestamp - rec.timestamp) + o.gate_margin;
+  }
+  int best_inliers = 0;
+  std::optional<Frame> best_frame;
+  map::KeyFrame* best_keyframe = nullptr;
   for (const auto& c : candidates) {
     map::KeyFrame* kf = c.keyframe;
     const auto kf_place = database_->description(kf);
@@ -79,15 +93,31 @@ bool Tracker::relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id) {
     const int inliers = optimize_pose(c_frame, t);
     c_frame.discard_outliers();
     if (inliers < o.min_inliers) continue;
+    if (last_centre) {
+      const double moved = (c_frame.camera_center() - *last_centre).norm();
+      if (moved > reach) {
+        spdlog::debug("frame {}: relocalization against keyframe {} rejected: {:.1f} m from the last tracked pose, "
+                      "at most {:.1f} m reachable",
+                      f.id(), kf->id(), moved, reach);
+        continue;
+      }
+    }
+    // Every candidate is verified and the one with the most inliers wins: a look-alike place
+    // (a repeated window, desk or shelf) can pass the threshold too, and may score first, but the
+    // true place also matches what differs around it.
+    if (inliers <= best_inliers) continue;
+    best_inliers = inliers;
     c_frame.reference = kf;
-    reference_ = kf;
-    keyframe_id = kf->id();
-    f = std::move(c_frame);
-    found = true;
-    break;
+    best_frame = std::move(c_frame);
+    best_keyframe = kf;
+  }
+  if (best_keyframe) {
+    reference_ = best_keyframe;
+    keyframe_id = best_keyframe->id();
+    f = std::move(*best_frame);
   }
   t.track_motion_ms += ms_since(t0);
-  return found;
+  return best_keyframe != nullptr;
 }
 
 }  // namespace plslam::tracking
