@@ -103,7 +103,7 @@ TEST_F(MapReuse, RestoredObjectsAreTheSavedOnes) {
     EXPECT_EQ(kfs[i]->id(), saved.id);
     EXPECT_TRUE(kfs[i]->pose().matrix() == saved.T_cw.matrix());
     EXPECT_EQ(kfs[i]->data().keypoints.size(), saved.data->keypoints.size());
-    EXPECT_FALSE(kfs[i]->data().grid.empty());
+    EXPECT_TRUE(kfs[i]->data().has_grid());
     for (const auto& [id, w] : saved.covisibility) {
       const auto it = std::find_if(kfs.begin(), kfs.end(), [id = id](auto* k) { return k->id() == id; });
       ASSERT_NE(it, kfs.end());

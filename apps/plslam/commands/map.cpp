@@ -14,7 +14,9 @@
 #include "plslam/io/map_export.h"
 #include "plslam/io/output_folder.h"
 #include "plslam/io/trajectory_io.h"
+#include "plslam/core/error.h"
 #include "plslam/system/map_file.h"
+#include "plslam/system/system_config.h"
 
 namespace plslam::cli {
 namespace {
@@ -23,8 +25,32 @@ namespace fs = std::filesystem;
 
 struct MapInfoArgs {
   std::string file;
+  std::string vocabulary;
   bool json = false;
+  bool check = false;
 };
+
+// --check: the file restores into a map (and keyframe database) that saves to the same bytes.
+nlohmann::json check_round_trip(const system::MapContents& contents, const MapInfoArgs& args) {
+  const std::string original = system::map_to_bytes(contents);
+  system::SystemOptions options;
+  if (!args.vocabulary.empty()) options.vocabulary = args.vocabulary;
+  const auto vocabulary = system::load_vocabulary(options);
+  if (contents.meta.vocabulary_checksum != 0 && vocabulary->checksum() != contents.meta.vocabulary_checksum) {
+    throw InputError(args.file, fmt::format("made with vocabulary {:016x}, not {:016x} (pass --vocabulary)",
+                                            contents.meta.vocabulary_checksum, vocabulary->checksum()));
+  }
+  map::Map map;
+  place::KeyframeDatabase database(vocabulary);
+  auto t0 = std::chrono::steady_clock::now();
+  system::restore_map(contents, map, &database);
+  const double restore_ms = ms_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  auto meta = contents.meta;
+  const std::string again = system::map_to_bytes(system::capture_map(map, &database, meta));
+  const double write_ms = ms_since(t0);
+  return {{"restore_ms", restore_ms}, {"capture_and_serialize_ms", write_ms}, {"identical", again == original}};
+}
 
 struct MapExportArgs {
   std::string file;
@@ -102,10 +128,12 @@ nlohmann::json map_info_json(const system::MapContents& c, const fs::path& file,
 int run_map_info(const MapInfoArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto contents = system::load_map_file(args.file);
-  const auto j = map_info_json(contents, args.file, ms_since(t0));
+  auto j = map_info_json(contents, args.file, ms_since(t0));
+  if (args.check) j["check"] = check_round_trip(contents, args);
+  const int rc = args.check && !j["check"]["identical"].get<bool>() ? 1 : 0;
   if (args.json) {
     print_json(j.dump(2) + "\n");
-    return 0;
+    return rc;
   }
   std::cout << fmt::format("{}: plslam map version {}, {} bytes, read in {:.1f} ms\n", args.file,
                            j["version"].get<int>(), j["bytes"].get<std::size_t>(), j["load_ms"].get<double>());
@@ -127,7 +155,13 @@ int run_map_info(const MapInfoArgs& args) {
                              e["max"][1].get<double>(), e["min"][2].get<double>(), e["max"][2].get<double>());
   }
   std::cout << "config:\n" << contents.meta.config << "\n";
-  return 0;
+  if (args.check) {
+    const auto& c = j["check"];
+    std::cout << fmt::format("check: restored in {:.1f} ms, saved again in {:.1f} ms: {}\n", c["restore_ms"].get<double>(),
+                             c["capture_and_serialize_ms"].get<double>(),
+                             c["identical"].get<bool>() ? "identical bytes" : "DIFFERENT BYTES");
+  }
+  return rc;
 }
 
 int run_map_export(const MapExportArgs& args) {
@@ -152,6 +186,11 @@ CommandRegistration reg({"map", "Inspect and export a saved map (.plmap)", [](CL
                            CLI::App* info = sub.add_subcommand("info", "Counts, extent, calibration, vocabulary and config");
                            info->add_option("file", info_args->file, "Map file")->required();
                            info->add_flag("--json", info_args->json, "Print a JSON object");
+                           info->add_flag("--check", info_args->check,
+                                          "Restore the map and save it again in memory: the bytes must be the same "
+                                          "(exit 1 if not); with the times");
+                           info->add_option("--vocabulary", info_args->vocabulary,
+                                            "Vocabulary for --check (default: the one in data/vocabulary)");
                            auto export_args = std::make_shared<MapExportArgs>();
                            CLI::App* exp = sub.add_subcommand(
                                "export", "Write map_points.ply, map_lines.ply and keyframes.tum, as run does");

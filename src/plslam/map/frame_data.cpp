@@ -6,19 +6,28 @@
 namespace plslam::map {
 
 void FrameData::build_grid() {
-  grid.assign(static_cast<std::size_t>(kGridCols * kGridRows), {});
+  constexpr std::size_t kCells = static_cast<std::size_t>(kGridCols * kGridRows);
   const double cw = static_cast<double>(calib.width) / kGridCols;
   const double ch = static_cast<double>(calib.height) / kGridRows;
+  std::vector<int> cell(keypoints.size());
+  grid_offsets.assign(kCells + 1, 0);
   for (std::size_t i = 0; i < keypoints.size(); ++i) {
     const int cx = std::clamp(static_cast<int>(keypoints[i].pt.x / cw), 0, kGridCols - 1);
     const int cy = std::clamp(static_cast<int>(keypoints[i].pt.y / ch), 0, kGridRows - 1);
-    grid[static_cast<std::size_t>(cy * kGridCols + cx)].push_back(static_cast<int>(i));
+    cell[i] = cy * kGridCols + cx;
+    ++grid_offsets[static_cast<std::size_t>(cell[i]) + 1];
+  }
+  for (std::size_t c = 0; c < kCells; ++c) grid_offsets[c + 1] += grid_offsets[c];
+  grid_indices.resize(keypoints.size());
+  std::vector<int> next(grid_offsets.begin(), grid_offsets.end() - 1);
+  for (std::size_t i = 0; i < keypoints.size(); ++i) {
+    grid_indices[static_cast<std::size_t>(next[static_cast<std::size_t>(cell[i])]++)] = static_cast<int>(i);
   }
 }
 
 std::vector<int> FrameData::points_in_area(double u, double v, double r, int min_level, int max_level) const {
   std::vector<int> out;
-  if (grid.empty()) return out;
+  if (!has_grid()) return out;
   const double cw = static_cast<double>(calib.width) / kGridCols;
   const double ch = static_cast<double>(calib.height) / kGridRows;
   const int x0 = std::max(0, static_cast<int>(std::floor((u - r) / cw)));
@@ -29,7 +38,9 @@ std::vector<int> FrameData::points_in_area(double u, double v, double r, int min
   const double r2 = r * r;
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
-      for (int i : grid[static_cast<std::size_t>(y * kGridCols + x)]) {
+      const auto c = static_cast<std::size_t>(y * kGridCols + x);
+      for (int k = grid_offsets[c]; k < grid_offsets[c + 1]; ++k) {
+        const int i = grid_indices[static_cast<std::size_t>(k)];
         const auto& kp = keypoints[static_cast<std::size_t>(i)];
         if (kp.octave < min_level || (max_level >= 0 && kp.octave > max_level)) continue;
         const double dx = kp.pt.x - u, dy = kp.pt.y - v;

@@ -39,9 +39,14 @@ struct FrameData {
   std::vector<LineObservation> lines;
   cv::Mat line_descriptors;  // M x 32 CV_8U (LBD)
 
-  // Grid of keypoint indices over the left image, built by build_grid().
+  // Grid of keypoint indices over the left image, built by build_grid(): the indices of cell c
+  // (row-major) are grid_indices[grid_offsets[c] .. grid_offsets[c + 1]), increasing. Two flat
+  // arrays instead of a vector per cell: one allocation each, for every frame and every keyframe
+  // read from a map file.
   static constexpr int kGridCols = 64, kGridRows = 48;
-  std::vector<std::vector<int>> grid;
+  std::vector<int> grid_offsets;
+  std::vector<int> grid_indices;
+  bool has_grid() const { return !grid_offsets.empty(); }
 
   void build_grid();
   // Indices of keypoints within radius r of (u, v) whose level lies in [min_level, max_level]

@@ -25,6 +25,7 @@ class KeyFrame {
 
   long id() const { return id_; }
   const FrameData& data() const { return *data_; }
+  const std::shared_ptr<const FrameData>& shared_data() const { return data_; }
   long frame_id() const { return data_->frame_id; }
   double timestamp() const { return data_->timestamp; }
 

@@ -23,6 +23,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -58,7 +59,7 @@ struct MapFileMeta {
 
 struct SavedKeyframe {
   long id = 0;
-  std::shared_ptr<map::FrameData> data;  // calib from the meta section; grid built on restore
+  std::shared_ptr<const map::FrameData> data;  // calib from the meta section; grid built on reading
   geometry::SE3 T_cw;
   std::shared_ptr<const place::PlaceDescription> place;  // null when it was not in the database
   long parent = -1;                                      // -1: a spanning-tree root
@@ -98,10 +99,11 @@ struct MapReadOptions {
 };
 // Parses and checks everything (structure, sizes, ids, indices, finite numbers): InputError(source,
 // one line) for any problem.
-MapContents map_from_bytes(const std::string& bytes, const std::string& source, const MapReadOptions& options = {});
+MapContents map_from_bytes(std::string_view bytes, const std::string& source, const MapReadOptions& options = {});
 
 // Builds the saved objects into an empty map, and indexes the keyframes that had a description
-// in `database` (may be null). Contents from map_from_bytes never fail here.
+// in `database` (may be null). Contents from map_from_bytes never fail here. The keyframes share
+// their FrameData with `contents` (immutable), so nothing is copied.
 void restore_map(const MapContents& contents, map::Map& map, place::KeyframeDatabase* database);
 
 // A map is used only with the calibration it was built with (resolution, intrinsics and baseline
@@ -112,6 +114,7 @@ void check_map_matches(const MapFileMeta& meta, const StereoCalibration& calib, 
 
 // Atomic (a temporary name, then a rename): InputError naming the path when it cannot be written.
 void save_map_file(const std::filesystem::path& path, const MapContents& contents);
+// Reads through a private memory mapping of the file (no copy of its bytes).
 MapContents load_map_file(const std::filesystem::path& path);
 
 }  // namespace plslam::system
