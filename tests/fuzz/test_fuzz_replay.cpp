@@ -14,6 +14,7 @@
 #include "fuzz/targets/fuzz_euroc_sensor.cpp"
 #include "fuzz/targets/fuzz_frame_log.cpp"
 #include "fuzz/targets/fuzz_image.cpp"
+#include "fuzz/targets/fuzz_map_file.cpp"
 #include "fuzz/targets/fuzz_trajectory.cpp"
 #include "fuzz/targets/fuzz_vocabulary.cpp"
 
@@ -38,6 +39,7 @@ const Target kTargets[] = {
     {"kitti_times", fuzz_kitti_times},
     {"frame_log", fuzz_frame_log},
     {"image", fuzz_image},
+    {"map_file", fuzz_map_file},
     {"vocabulary", fuzz_vocabulary},
     {"bench_configs", fuzz_bench_configs},
 };

@@ -18,6 +18,7 @@
 #include "plslam/system/slam_system.h"
 #include "plslam/system/system_config.h"
 #include "support/test_support.h"
+#include "system/tiny_map.h"
 
 namespace plslam {
 namespace {
@@ -312,6 +313,79 @@ TEST_F(MapReuse, InfoAndExport) {
   EXPECT_EQ(rows, contents.keyframes.size());
   r = test::run_cli("map info \"" + (tmp_->path() / "nothing.plmap").string() + "\"");
   EXPECT_EQ(r.exit_code, 2);
+}
+
+}  // namespace
+}  // namespace plslam
+
+namespace plslam {
+namespace {
+
+// Exact data: every field written is read back as it was, and bytes -> contents -> bytes holds.
+TEST(MapFileFormat, HandMadeContentsRoundTripExactly) {
+  const auto c = test::tiny_map_contents();
+  const std::string bytes = system::map_to_bytes(c);
+  if (const char* seed = std::getenv("PLSLAM_WRITE_MAP_SEED")) std::ofstream(seed, std::ios::binary) << bytes;
+  const auto r = system::map_from_bytes(bytes, "tiny.plmap");
+  EXPECT_EQ(system::map_to_bytes(r), bytes);
+  EXPECT_EQ(r.meta.calib.cx, 31.5);
+  EXPECT_EQ(r.meta.vocabulary_checksum, 0x1234u);
+  ASSERT_TRUE(r.meta.T_gt_map.has_value());
+  EXPECT_TRUE(r.meta.T_gt_map->matrix() == c.meta.T_gt_map->matrix());
+  ASSERT_EQ(r.keyframes.size(), 2u);
+  const auto& k = r.keyframes[1];
+  EXPECT_EQ(k.parent, 0);
+  EXPECT_EQ(k.data->keypoints[2].angle, 90.f);
+  EXPECT_EQ(k.data->keypoints[1].octave, 1);
+  EXPECT_EQ(k.data->u_right[2], -1.f);
+  EXPECT_EQ(k.data->descriptors.at<unsigned char>(2, 31), 8);
+  EXPECT_EQ(k.data->lines[0].end_cam, Eigen::Vector3d(0.5, 0.3, 2.5));
+  EXPECT_TRUE(k.data->lines[0].stereo);
+  EXPECT_TRUE(k.data->has_grid());
+  ASSERT_NE(k.place, nullptr);
+  EXPECT_EQ(k.place->features[0].second, (std::vector<std::uint32_t>{0, 2}));
+  EXPECT_EQ(r.points[0].observations, c.points[0].observations);
+  EXPECT_EQ(r.points[0].visible, 4);
+  EXPECT_EQ(r.lines[0].b, c.lines[0].b);
+  map::Map map;
+  system::restore_map(r, map, nullptr);
+  EXPECT_EQ(map.keyframes()[1]->parent(), map.keyframes()[0]);
+  EXPECT_EQ(map.keyframes()[0]->loop_edges().size(), 1u);
+  EXPECT_EQ(map.points()[0]->observation_weight(), 4);  // two stereo observations
+  EXPECT_EQ(map.next_ids().point, 5);
+}
+
+// What the structure checks catch behind valid checksums.
+TEST(MapFileFormat, InconsistentContentsAreRejected) {
+  const std::vector<std::pair<std::function<void(system::MapContents&)>, std::string>> cases = {
+      {[](auto& c) { c.points[0].observations[1].second = 7; }, "out of range"},
+      {[](auto& c) { c.points[0].observations[1].first = 9; }, "unknown keyframe 9"},
+      {[](auto& c) {
+         c.lines.push_back(c.lines[0]);
+         c.lines[1].id = 3;
+         c.meta.next_ids.line = 4;
+       }, "holds two lines"},
+      {[](auto& c) { c.keyframes[0].parent = 1; }, "cycle"},
+      {[](auto& c) { c.keyframes[1].covisibility = {{5, 1}}; }, "unknown keyframe 5"},
+      {[](auto& c) { c.points[0].id = 9; }, "next id"},
+      {[](auto& c) { c.meta.calib.baseline = 0; }, "calibration"},
+      {[](auto& c) { c.keyframes[0].T_cw = geometry::SE3(2 * Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()); }, "rotation"},
+      {[](auto& c) {
+         auto p = std::make_shared<place::PlaceDescription>(*c.keyframes[0].place);
+         p->bow[1].first = 10;
+         c.keyframes[0].place = p;
+       }, "bad word"},
+  };
+  for (const auto& [edit, expected] : cases) {
+    auto c = test::tiny_map_contents();
+    edit(c);
+    try {
+      system::map_from_bytes(system::map_to_bytes(c), "tiny.plmap");
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace
