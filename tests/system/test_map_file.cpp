@@ -8,6 +8,8 @@
 #include <memory>
 #include <random>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -29,18 +31,33 @@ constexpr int kFrames = 40;
 
 class MapReuse : public ::testing::Test {
  protected:
+  // The rendered sequence and its map are made once per build folder and kept (ctest runs every
+  // test in its own process, and under the sanitizers of CI the render and the mapping run cost
+  // about 20 s). Processes that race to make them each render into a folder of their own, and the
+  // first rename wins. The key holds the map format version: a new format maps again.
   static void SetUpTestSuite() {
     tmp_ = std::make_unique<test::TempDir>();
-    auto r = test::run_cli("synth --out \"" + sequence().string() + "\" --scene office --preset euroc --frames " +
-                           std::to_string(kFrames) + " --seed 3 --threads 2");
+    const fs::path cache_root = fs::path(PLSLAM_CLI_PATH).parent_path() / "test_cache";
+    cache_ = cache_root / ("map_reuse_v" + std::to_string(system::kMapFileVersion));
+    if (fs::exists(cache_ / "office.plmap")) return;
+    fs::create_directories(cache_root);
+    const fs::path work = cache_root / (".map_reuse." + std::to_string(::getpid()));
+    fs::remove_all(work);
+    auto r = test::run_cli("synth --out \"" + (work / "office").string() +
+                           "\" --scene office --preset euroc --frames " + std::to_string(kFrames) +
+                           " --seed 3 --threads 2");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    r = test::run_cli("run \"" + sequence().string() + "\" --out \"" + (tmp_->path() / "mapping").string() +
-                      "\" --quiet --sequential --save-map \"" + map_file().string() + "\"");
+    r = test::run_cli("run \"" + (work / "office").string() + "\" --out \"" + (work / "mapping").string() +
+                      "\" --quiet --sequential --save-map \"" + (work / "office.plmap").string() + "\"");
     ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::error_code ec;
+    fs::rename(work, cache_, ec);
+    if (ec) fs::remove_all(work);  // another process was first
+    ASSERT_TRUE(fs::exists(cache_ / "office.plmap"));
   }
   static void TearDownTestSuite() { tmp_.reset(); }
-  static fs::path sequence() { return tmp_->path() / "office"; }
-  static fs::path map_file() { return tmp_->path() / "office.plmap"; }
+  static fs::path sequence() { return cache_ / "office"; }
+  static fs::path map_file() { return cache_ / "office.plmap"; }
   static std::string map_bytes() { return test::read_file(map_file()); }
 
   // A copy of the map with `edit` applied to its contents, saved under `name`.
@@ -62,9 +79,11 @@ class MapReuse : public ::testing::Test {
   }
 
   static std::unique_ptr<test::TempDir> tmp_;
+  static fs::path cache_;
 };
 
 std::unique_ptr<test::TempDir> MapReuse::tmp_;
+fs::path MapReuse::cache_;
 
 std::unique_ptr<system::System> make_system(const io::Dataset& ds, bool localization_only = false) {
   auto options = system::load_system_options(ds.format(), std::nullopt);
