@@ -364,7 +364,7 @@ TEST(MapFileFormat, HandMadeContentsRoundTripExactly) {
   ASSERT_NE(k.place, nullptr);
   EXPECT_EQ(k.place->features[0].second, (std::vector<std::uint32_t>{0, 2}));
   EXPECT_EQ(r.points[0].observations, c.points[0].observations);
-  EXPECT_EQ(r.points[0].visible, 4);
+  EXPECT_EQ(r.points[0].state.visible, 4);
   EXPECT_EQ(r.lines[0].b, c.lines[0].b);
   map::Map map;
   system::restore_map(r, map, nullptr);

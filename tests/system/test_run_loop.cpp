@@ -56,7 +56,9 @@ class LoopRun : public ::testing::Test {
     EXPECT_EQ(stats["loop_correction_ms"].size(), stats["loops"].size());
     // A sanity bound, not the loop's gain: with loop closing 0.008-0.017 m (5 runs, 2 of them on
     // one core shared with a busy loop; 0.0163 once under ASan), without it 0.013-0.019.
-    EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.02);
+    EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.02)
+        << "keyframes " << stats["keyframes"] << ", lost " << stats["lost_events"] << ", relocalizations "
+        << stats["relocalizations"].dump() << ", loops " << stats["loops"].dump();
   }
 
   static std::unique_ptr<test::TempDir> tmp_;

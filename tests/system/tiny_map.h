@@ -66,12 +66,12 @@ inline system::MapContents tiny_map_contents() {
   p.reference = 0;
   p.a = Eigen::Vector3d(0.1, 0.2, 1.5);
   p.level0_max_distance = 1.8;
-  p.normal = Eigen::Vector3d(0, 0, -1);
-  p.min_distance = 0.3;
-  p.max_distance = 2.2;
-  p.descriptor = cv::Mat(1, 32, CV_8U, cv::Scalar(7));
-  p.visible = 4;
-  p.found = 3;
+  p.state.normal = Eigen::Vector3d(0, 0, -1);
+  p.state.min_distance = 0.3;
+  p.state.max_distance = 2.2;
+  p.state.descriptor = cv::Mat(1, 32, CV_8U, cv::Scalar(7));
+  p.state.visible = 4;
+  p.state.found = 3;
   p.observations = {{0, 0}, {1, 1}};
   c.points.push_back(p);
   system::SavedLandmark l = p;

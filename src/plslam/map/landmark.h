@@ -21,6 +21,15 @@ namespace plslam::map {
 
 class KeyFrame;
 
+// A landmark's representative descriptor, viewing direction and distance range, and tracking
+// statistics (see Landmark).
+struct LandmarkState {
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double min_distance = 0, max_distance = 0;
+  cv::Mat descriptor;  // 1 x 32 CV_8U, or empty
+  int visible = 1, found = 1;
+};
+
 template <class Derived>
 class Landmark {
  public:
@@ -64,14 +73,8 @@ class Landmark {
 
   // What a map file stores beyond the position and the observations (system/map_file): restored
   // as saved rather than recomputed, so that save -> load -> save gives the same bytes.
-  struct SavedState {
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-    double min_distance = 0, max_distance = 0;
-    cv::Mat descriptor;
-    int visible = 1, found = 1;
-  };
-  SavedState saved_state() const;
-  void restore_state(const SavedState& s);
+  LandmarkState saved_state() const;
+  void restore_state(const LandmarkState& s);
 
  protected:
   // For update_normal_and_depth() of the derived class: the mean viewing direction and range.

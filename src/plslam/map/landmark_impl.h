@@ -183,13 +183,13 @@ void Landmark<D>::replace_with(D* other) {
 }
 
 template <class D>
-typename Landmark<D>::SavedState Landmark<D>::saved_state() const {
+LandmarkState Landmark<D>::saved_state() const {
   std::lock_guard lock(mutex_);
   return {normal_, min_distance_, max_distance_, descriptor_.clone(), visible_, found_};
 }
 
 template <class D>
-void Landmark<D>::restore_state(const SavedState& s) {
+void Landmark<D>::restore_state(const LandmarkState& s) {
   std::lock_guard lock(mutex_);
   normal_ = s.normal;
   min_distance_ = s.min_distance;

@@ -158,12 +158,12 @@ void write_landmark(Writer& w, const SavedLandmark& l, bool line) {
   } else {
     w.put<double>(l.level0_max_distance);
   }
-  w.put_vec3(l.normal);
-  w.put<double>(l.min_distance);
-  w.put<double>(l.max_distance);
-  w.put_descriptor(l.descriptor);
-  w.put<std::int32_t>(l.visible);
-  w.put<std::int32_t>(l.found);
+  w.put_vec3(l.state.normal);
+  w.put<double>(l.state.min_distance);
+  w.put<double>(l.state.max_distance);
+  w.put_descriptor(l.state.descriptor);
+  w.put<std::int32_t>(l.state.visible);
+  w.put<std::int32_t>(l.state.found);
   w.put_count(l.observations.size());
   for (const auto& [kf, index] : l.observations) {
     w.put<std::int64_t>(kf);
@@ -404,13 +404,13 @@ SavedLandmark read_landmark(Reader& r, bool line, long next_id) {
   } else {
     l.level0_max_distance = r.get_finite();
   }
-  l.normal = r.get_vec3();
-  l.min_distance = r.get_finite();
-  l.max_distance = r.get_finite();
-  l.descriptor = r.get_descriptor();
-  l.visible = r.get<std::int32_t>();
-  l.found = r.get<std::int32_t>();
-  if (l.visible < 0 || l.found < 0) r.fail(fmt::format("{} {}: negative statistics", what, l.id));
+  l.state.normal = r.get_vec3();
+  l.state.min_distance = r.get_finite();
+  l.state.max_distance = r.get_finite();
+  l.state.descriptor = r.get_descriptor();
+  l.state.visible = r.get<std::int32_t>();
+  l.state.found = r.get<std::int32_t>();
+  if (l.state.visible < 0 || l.state.found < 0) r.fail(fmt::format("{} {}: negative statistics", what, l.id));
   const std::size_t n = r.count(12);
   l.observations.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -544,13 +544,7 @@ MapContents capture_map(const map::Map& map, const place::KeyframeDatabase* data
     }
     const auto* ref = landmark->reference();
     l.reference = known(ref) ? ref->id() : (l.observations.empty() ? -1 : l.observations.front().first);
-    const auto s = landmark->saved_state();
-    l.normal = s.normal;
-    l.min_distance = s.min_distance;
-    l.max_distance = s.max_distance;
-    l.descriptor = s.descriptor;
-    l.visible = s.visible;
-    l.found = s.found;
+    l.state = landmark->saved_state();
   };
   for (const auto* p : map.points()) {
     SavedLandmark l;
@@ -696,16 +690,13 @@ void restore_map(const MapContents& c, map::Map& map, place::KeyframeDatabase* d
   for (const auto& k : c.keyframes) {
     kfs[k.id] = map.restore_keyframe(k.id, k.data, k.T_cw);
   }
-  auto restore_state = [&](auto* landmark, const SavedLandmark& l) {
-    landmark->restore_state({l.normal, l.min_distance, l.max_distance, l.descriptor, l.visible, l.found});
-  };
   for (const auto& l : c.points) {
     auto* p = map.restore_point(l.id, l.a, kfs.at(l.reference), l.created_frame);
     for (const auto& [kf, index] : l.observations) {
       kfs.at(kf)->add_map_point(p, index);
       p->add_observation(kfs.at(kf), index);
     }
-    restore_state(p, l);
+    p->restore_state(l.state);
     p->restore_level0_max_distance(l.level0_max_distance);
   }
   for (const auto& l : c.lines) {
@@ -714,7 +705,7 @@ void restore_map(const MapContents& c, map::Map& map, place::KeyframeDatabase* d
       kfs.at(kf)->add_map_line(ml, index);
       ml->add_observation(kfs.at(kf), index);
     }
-    restore_state(ml, l);
+    ml->restore_state(l.state);
   }
   for (const auto& k : c.keyframes) {
     map::IdMap<map::KeyFrame, int> weights;

@@ -74,10 +74,7 @@ struct SavedLandmark {
   long reference = -1;  // keyframe id
   Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
   double level0_max_distance = 0;  // points only
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  double min_distance = 0, max_distance = 0;
-  cv::Mat descriptor;  // 1 x 32 CV_8U, or empty
-  int visible = 1, found = 1;
+  map::LandmarkState state;
   std::vector<std::pair<long, int>> observations;  // keyframe id, feature index; by id
 };
 
