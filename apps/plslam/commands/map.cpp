@@ -1,6 +1,8 @@
 // plslam map info FILE [--json] | map export FILE --out DIR: what a saved map (.plmap) holds, and
 // its points, lines and keyframe poses as the PLY and TUM files that `plslam run` writes.
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <iostream>
 #include <limits>
 
@@ -15,6 +17,7 @@
 #include "plslam/io/output_folder.h"
 #include "plslam/io/trajectory_io.h"
 #include "plslam/core/error.h"
+#include "plslam/core/input_file.h"
 #include "plslam/system/map_file.h"
 #include "plslam/system/system_config.h"
 
@@ -30,9 +33,14 @@ struct MapInfoArgs {
   bool check = false;
 };
 
-// --check: the file restores into a map (and keyframe database) that saves to the same bytes.
+std::string read_whole_file(const fs::path& path) {
+  std::ifstream in = open_input_file(path, "map file not found");
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// --check: the file restores into a map (and keyframe database) that saves to the file's own bytes.
 nlohmann::json check_round_trip(const system::MapContents& contents, const MapInfoArgs& args) {
-  const std::string original = system::map_to_bytes(contents);
+  const std::string original = read_whole_file(args.file);
   system::SystemOptions options;
   if (!args.vocabulary.empty()) options.vocabulary = args.vocabulary;
   const auto vocabulary = system::load_vocabulary(options);

@@ -35,8 +35,7 @@ bool Tracker::relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id) {
     reach = o.max_speed * std::max(0.0, f.data->timestamp - rec.timestamp) + o.gate_margin;
   }
   int best_inliers = 0;
-  std::optional<Frame> best_frame;
-  map::KeyFrame* best_keyframe = nullptr;
+  std::optional<Frame> best_frame;  // its reference is the candidate keyframe
   for (const auto& c : candidates) {
     map::KeyFrame* kf = c.keyframe;
     const auto kf_place = database_->description(kf);
@@ -109,15 +108,14 @@ bool Tracker::relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id) {
     best_inliers = inliers;
     c_frame.reference = kf;
     best_frame = std::move(c_frame);
-    best_keyframe = kf;
   }
-  if (best_keyframe) {
-    reference_ = best_keyframe;
-    keyframe_id = best_keyframe->id();
+  if (best_frame) {
+    reference_ = best_frame->reference;
+    keyframe_id = reference_->id();
     f = std::move(*best_frame);
   }
   t.track_motion_ms += ms_since(t0);
-  return best_keyframe != nullptr;
+  return best_frame.has_value();
 }
 
 }  // namespace plslam::tracking
