@@ -1,5 +1,10 @@
 #include "plslam/system/system_config.h"
 
+#include <cstdlib>
+#include <filesystem>
+#include <system_error>
+#include <vector>
+
 #include <fmt/format.h>
 
 #include "plslam/core/error.h"
@@ -136,7 +141,28 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
   return o;
 }
 
-std::filesystem::path default_vocabulary_path() { return PLSLAM_DEFAULT_VOCABULARY; }
+std::filesystem::path default_vocabulary_path() {
+  // The source tree's copy (a build tree), then the installed one: beside the running program
+  // (<prefix>/bin/../share/plslam, wherever the prefix was moved) or at the configured prefix (a
+  // program that embeds the library and lives elsewhere).
+  const std::filesystem::path source = PLSLAM_DEFAULT_VOCABULARY;
+  const auto name = source.filename();
+  // PLSLAM_DATA_DIR (<prefix>/share/plslam) names an installed copy explicitly, for a prefix moved
+  // after the build.
+  if (const char* dir = std::getenv("PLSLAM_DATA_DIR"); dir && *dir) {
+    return std::filesystem::path(dir) / "vocabulary" / name;
+  }
+  std::vector<std::filesystem::path> candidates = {source};
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) candidates.push_back(exe.parent_path().parent_path() / "share/plslam/vocabulary" / name);
+  const std::filesystem::path installed = std::filesystem::path(PLSLAM_INSTALL_DATA_DIR) / "vocabulary" / name;
+  candidates.push_back(installed);
+  for (const auto& c : candidates) {
+    if (std::filesystem::is_regular_file(c, ec)) return c;
+  }
+  return installed;  // missing: loading it names this path
+}
 
 std::shared_ptr<const place::Vocabulary> load_vocabulary(const SystemOptions& o) {
   if (!o.place_recognition) return nullptr;

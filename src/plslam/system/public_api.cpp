@@ -1,0 +1,274 @@
+// plslam::Slam (plslam/plslam.h): the public API over system::System.
+#include <cmath>
+#include <optional>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "plslam/core/version.h"
+#include "plslam/eval/evaluate.h"
+#include "plslam/io/calibration_file.h"
+#include "plslam/io/dataset.h"
+#include "plslam/plslam.h"
+#include "plslam/system/map_file.h"
+#include "plslam/system/slam_system.h"
+#include "plslam/system/system_config.h"
+
+namespace plslam {
+
+const char* version() { return kVersion; }
+
+const char* to_string(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNotInitialized: return "not_initialized";
+    case TrackingState::kTracking: return "tracking";
+    case TrackingState::kLost: return "lost";
+  }
+  return "?";
+}
+
+namespace {
+
+TrackingState public_state(tracking::TrackingState s) {
+  switch (s) {
+    case tracking::TrackingState::kNotInitialized: return TrackingState::kNotInitialized;
+    case tracking::TrackingState::kOk: return TrackingState::kTracking;
+    case tracking::TrackingState::kLost: return TrackingState::kLost;
+  }
+  return TrackingState::kLost;
+}
+
+void check_calibration(const StereoCalibration& c) {
+  const bool ok = c.width > 0 && c.height > 0 && std::isfinite(c.fx) && c.fx > 0 && std::isfinite(c.fy) &&
+                  c.fy > 0 && std::isfinite(c.cx) && std::isfinite(c.cy) && std::isfinite(c.baseline) &&
+                  c.baseline > 0;
+  if (!ok) {
+    throw InputError("", fmt::format("calibration: width, height, fx, fy and baseline must be positive and finite "
+                                     "(got {}x{}, fx {}, fy {}, baseline {})",
+                                     c.width, c.height, c.fx, c.fy, c.baseline));
+  }
+}
+
+system::SystemOptions system_options(const SlamOptions& o) {
+  auto options = system::load_system_options(
+      o.preset == Preset::kKitti ? io::DatasetFormat::kKitti : io::DatasetFormat::kEuroc,
+      o.config_file.empty() ? std::nullopt : std::optional(o.config_file));
+  if (!o.lines) options.disable_lines();
+  if (!o.vocabulary.empty()) options.vocabulary = o.vocabulary;
+  if (!o.place_recognition) options.place_recognition = false;
+  if (!o.loop_closing) options.loop_closing = false;
+  options.sequential = o.sequential;
+  options.localization_only = o.localization_only;
+  return options;
+}
+
+// The extractor works on 8-bit grey; a colour camera's BGR is converted.
+cv::Mat grey_image(const cv::Mat& image, const char* side, const StereoCalibration& calib) {
+  if (image.empty()) throw InputError("", fmt::format("track: the {} image is empty", side));
+  if (image.cols != calib.width || image.rows != calib.height) {
+    throw InputError("", fmt::format("track: the {} image is {}x{}, the calibration says {}x{}", side, image.cols,
+                                     image.rows, calib.width, calib.height));
+  }
+  if (image.type() == CV_8UC1) return image;
+  cv::Mat grey;
+  if (image.type() == CV_8UC3) {
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  } else if (image.type() == CV_8UC4) {
+    cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+  } else {
+    throw InputError("", fmt::format("track: the {} image must be 8-bit grey or BGR (OpenCV type {})", side,
+                                     image.type()));
+  }
+  return grey;
+}
+
+}  // namespace
+
+StereoCalibration read_calibration(const std::filesystem::path& file) {
+  auto c = io::read_calibration_file(file);
+  try {
+    check_calibration(c);
+  } catch (const InputError& e) {
+    throw InputError(file.string(), e.problem());
+  }
+  return c;
+}
+
+struct Sequence::Impl {
+  std::unique_ptr<io::Dataset> dataset;
+};
+
+Sequence::Sequence(const std::filesystem::path& folder) : impl_(std::make_unique<Impl>()) {
+  impl_->dataset = io::open_dataset(folder);
+}
+Sequence::~Sequence() = default;
+Sequence::Sequence(Sequence&&) noexcept = default;
+Sequence& Sequence::operator=(Sequence&&) noexcept = default;
+std::size_t Sequence::size() const { return impl_->dataset->size(); }
+const StereoCalibration& Sequence::calibration() const { return impl_->dataset->calibration(); }
+Preset Sequence::preset() const {
+  return impl_->dataset->format() == io::DatasetFormat::kKitti ? Preset::kKitti : Preset::kEuroc;
+}
+StereoImages Sequence::frame(std::size_t i) const {
+  if (i >= size()) throw std::out_of_range(fmt::format("plslam::Sequence::frame: {} of {}", i, size()));
+  auto f = impl_->dataset->load(i);
+  return {f.timestamp, std::move(f.left), std::move(f.right)};
+}
+const Trajectory* Sequence::ground_truth() const {
+  const auto& gt = impl_->dataset->ground_truth();
+  return gt ? &*gt : nullptr;
+}
+
+TrajectoryErrors evaluate_trajectory(const Trajectory& ground_truth, const Trajectory& estimate) {
+  const auto r = eval::evaluate(ground_truth, estimate, eval::EvalOptions{});
+  TrajectoryErrors e;
+  e.pairs = r.pairs.size();
+  e.ate_rmse_m = r.ape_trans_stats.rmse;
+  e.rpe_trans_rmse_m = r.rpe_trans_stats.rmse;
+  e.rpe_rot_rmse_deg = r.rpe_rot_stats.rmse;
+  return e;
+}
+
+struct Slam::Impl {
+  Impl(const StereoCalibration& c, const SlamOptions& o) : calib(c), options(o) {
+    check_calibration(c);
+    const auto sys_options = system_options(o);
+    vocabulary = system::load_vocabulary(sys_options);
+    slam = std::make_unique<system::System>(calib, sys_options, vocabulary);
+  }
+
+  StereoCalibration calib;
+  SlamOptions options;
+  std::shared_ptr<const place::Vocabulary> vocabulary;
+  std::unique_ptr<system::System> slam;
+  long frames = 0;
+  long tracked = 0;
+  std::optional<double> last_timestamp;
+  bool shut_down = false;
+  std::optional<geometry::SE3> T_gt_map;  // a loaded map's ground-truth anchor, kept on save
+};
+
+Slam::Slam(const StereoCalibration& calibration, const SlamOptions& options)
+    : impl_(std::make_unique<Impl>(calibration, options)) {}
+
+Slam::~Slam() {
+  if (impl_) shutdown();
+}
+
+Slam::Slam(Slam&&) noexcept = default;
+Slam& Slam::operator=(Slam&&) noexcept = default;
+
+TrackedFrame Slam::track(const cv::Mat& left, const cv::Mat& right, double timestamp) {
+  auto& d = *impl_;
+  if (d.shut_down) throw std::logic_error("plslam::Slam::track: called after shutdown()");
+  if (!std::isfinite(timestamp) || (d.last_timestamp && timestamp <= *d.last_timestamp)) {
+    throw InputError("", fmt::format("track: timestamp {} does not follow the previous one ({})", timestamp,
+                                     d.last_timestamp ? *d.last_timestamp : NAN));
+  }
+  io::StereoFrame frame;
+  frame.index = static_cast<std::size_t>(d.frames);
+  frame.timestamp = timestamp;
+  frame.left = grey_image(left, "left", d.calib);
+  frame.right = grey_image(right, "right", d.calib);
+  const auto r = d.slam->process(frame);
+  d.last_timestamp = timestamp;
+  ++d.frames;
+
+  TrackedFrame out;
+  out.index = r.frame_id;
+  out.timestamp = r.timestamp;
+  out.state = public_state(r.track.state);
+  out.tracked = r.track.tracked;
+  if (r.track.tracked) {
+    // The frame's record: its pose relative to its reference keyframe, which is where the
+    // trajectory takes it from too.
+    const auto& record = d.slam->tracker().records().back();
+    out.T_world_camera = tracking::Tracker::pose_of(record).inverse().isometry();
+    ++d.tracked;
+  }
+  out.point_inliers = r.track.point_inliers;
+  out.line_inliers = r.track.line_inliers;
+  out.keyframe = r.track.keyframe;
+  out.relocalized = r.track.relocalized;
+  out.new_map_segment = r.track.new_map_segment;
+  out.tracking_ms = r.tracking_ms;
+  return out;
+}
+
+Trajectory Slam::trajectory() const { return impl_->slam->tracked_trajectory(); }
+
+MapSnapshot Slam::map() const {
+  const auto& m = impl_->slam->map();
+  MapSnapshot s;
+  // Landmarks stay allocated until the map is destroyed (culled ones are only unlisted), and each
+  // guards its own state, so reading them while local mapping runs is safe.
+  const auto points = m.points();
+  s.points.resize(static_cast<Eigen::Index>(points.size()), 3);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    s.points.row(static_cast<Eigen::Index>(i)) = points[i]->position().transpose();
+    s.point_ids.push_back(points[i]->id());
+  }
+  const auto lines = m.lines();
+  s.lines.resize(static_cast<Eigen::Index>(lines.size()), 6);
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const auto row = static_cast<Eigen::Index>(i);
+    s.lines.block<1, 3>(row, 0) = lines[i]->start().transpose();
+    s.lines.block<1, 3>(row, 3) = lines[i]->end().transpose();
+    s.line_ids.push_back(lines[i]->id());
+  }
+  s.keyframes = impl_->slam->keyframe_trajectory();
+  return s;
+}
+
+SlamStats Slam::stats() const {
+  const auto& sys = *impl_->slam;
+  SlamStats s;
+  s.frames = impl_->frames;
+  s.tracked = impl_->tracked;
+  s.lost_events = sys.tracker().lost_events();
+  s.relocalizations = static_cast<long>(sys.tracker().relocalized_frames().size());
+  s.loops = sys.loop_closer() ? static_cast<long>(sys.loop_closer()->stats().loops.size()) : 0;
+  s.keyframes = sys.map().num_keyframes();
+  s.points = sys.map().num_points();
+  s.lines = sys.map().num_lines();
+  return s;
+}
+
+const StereoCalibration& Slam::calibration() const { return impl_->calib; }
+
+void Slam::load_map(const std::filesystem::path& file) {
+  auto& d = *impl_;
+  if (d.frames > 0 || d.shut_down) {
+    throw std::logic_error("plslam::Slam::load_map: call it before the first track()");
+  }
+  const auto contents = system::load_map_file(file);
+  system::check_map_matches(contents.meta, d.calib, d.vocabulary.get(), file.string());
+  d.T_gt_map = contents.meta.T_gt_map;
+  d.slam->load_map(contents);
+}
+
+void Slam::save_map(const std::filesystem::path& file) {
+  shutdown();
+  auto& d = *impl_;
+  if (!d.slam->map().first_keyframe()) {
+    throw std::logic_error("plslam::Slam::save_map: the map is empty (tracking never initialised)");
+  }
+  system::MapFileMeta meta;
+  meta.created_by = fmt::format("plslam {} (library)", kVersion);
+  meta.T_gt_map = d.T_gt_map;
+  system::save_map_file(file, d.slam->capture_map(std::move(meta)));
+}
+
+void Slam::shutdown() {
+  if (impl_->shut_down) return;
+  impl_->shut_down = true;
+  impl_->slam->finish();
+}
+
+bool Slam::is_shut_down() const { return impl_->shut_down; }
+
+system::System& Slam::system() { return *impl_->slam; }
+const system::System& Slam::system() const { return *impl_->slam; }
+
+}  // namespace plslam
