@@ -33,7 +33,8 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "Stereo point-line visual SLAM: library, c
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3-numpy")
+# The Python module is built for the distribution's python3 (3.11 on Debian 12).
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3 (>= 3.11), python3 (<< 3.12), python3-numpy")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
   "libopencv-dev, libopencv-contrib-dev, libeigen3-dev, libceres-dev, libtbb-dev, libspdlog-dev, libfmt-dev, libyaml-cpp-dev, nlohmann-json3-dev, cmake")
 include(CPack)

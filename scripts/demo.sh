@@ -7,7 +7,8 @@ cd "$(dirname "$0")/.."
 BUILD_DIR=${BUILD_DIR:-build}
 bash scripts/install-deps.sh
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$BUILD_DIR" -j"$(nproc)"
+# The `plslam` command only: the tests, benchmarks and Python module are not needed for the demo.
+cmake --build "$BUILD_DIR" -j"$(nproc)" --target plslam
 
 # 480 frames at 20 Hz walk the 31 m office loop once (at 1.35 m/s) and return to the start.
 DATA="$BUILD_DIR/data/office_loop"
