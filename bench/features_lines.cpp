@@ -11,7 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/line_descriptor.hpp>
 
-#include "plslam/features/line_benchmark.h"
+#include "plslam/bench/line_benchmark.h"
 #include "plslam/features/line_extractor.h"
 #include "plslam/io/dataset.h"
 #include "plslam/matching/stereo_line_matcher.h"
@@ -150,7 +150,7 @@ void BM_LbdOpenCV(benchmark::State& state) {
   for (auto _ : state) {
     const std::size_t k = i++ % kept.size();
     state.PauseTiming();
-    auto kls = to_keylines(kept[k].second, s.frames[k].first.size());
+    auto kls = bench::to_keylines(kept[k].second, s.frames[k].first.size());
     state.ResumeTiming();
     cv::Mat desc;
     bd->compute(s.frames[k].first, kls, desc);

@@ -11,13 +11,13 @@
 #include <spdlog/spdlog.h>
 
 #include "json_stdout.h"
+#include "plslam/bench/point_benchmark.h"
 #include "plslam/bench/slam_bench.h"
 #include "plslam/bench/slam_figures.h"
 #include "plslam/core/error.h"
 #include "plslam/core/subprocess.h"
 #include "plslam/core/version.h"
 #include "plslam/eval/evaluate.h"
-#include "plslam/features/point_benchmark.h"
 #include "plslam/io/atomic_file.h"
 #include "plslam/io/output_folder.h"
 #include "plslam/io/trajectory_io.h"
@@ -248,9 +248,9 @@ int run_bench_slam(const BenchSlamArgs& a) {
     io::DatasetOptions o;
     o.max_frames = static_cast<std::size_t>(a.table1_frames);
     const auto ds = io::open_dataset(datasets[i].path, o);
-    features::PointBenchmarkOptions po;
+    bench::PointBenchmarkOptions po;
     po.stop = [] { return app::stop_requested(); };
-    const json j = features::run_point_benchmark(*ds, po);
+    const json j = bench::run_point_benchmark(*ds, po);
     table1[datasets[i].name] = {{"frames", j["frames"]}, {"ssc_ms", j["ssc_ms"]["median"]},
                                 {"quadtree_ms", j["quadtree_ms"]["median"]}, {"ssc_speedup", j["ssc_speedup"]}};
   }

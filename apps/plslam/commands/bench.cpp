@@ -11,10 +11,10 @@
 #include "command_registry.h"
 #include "commands/dataset_options.h"
 #include "json_stdout.h"
+#include "plslam/bench/line_benchmark.h"
+#include "plslam/bench/point_benchmark.h"
 #include "plslam/core/error.h"
 #include "plslam/core/sample_stats.h"
-#include "plslam/features/line_benchmark.h"
-#include "plslam/features/point_benchmark.h"
 #include "plslam/io/frame_stream.h"
 #include "plslam/tracking/frame_extractor.h"
 #include "stop_signals.h"
@@ -61,7 +61,7 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
   const auto stop = [] { return app::stop_requested(); };
   if (ds->size() == 0) throw InputError(args.dataset.path, "no frames selected");
-  features::PointBenchmarkOptions o;
+  bench::PointBenchmarkOptions o;
   o.n_features = args.n_features;
   o.orb.fast_mode = features::parse_fast_mode(args.fast_mode);
   o.orb.fast_threshold = args.fast_threshold;
@@ -71,15 +71,15 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   o.right_feature_factor = args.right_factor;
   o.stop = stop;
   if (!(o.right_feature_factor >= 1.0)) throw InputError("", "--right-factor must be >= 1");
-  nlohmann::json j = features::run_point_benchmark(*ds, o);
+  nlohmann::json j = bench::run_point_benchmark(*ds, o);
   // Lines: the same frames, one thread, with OpenCV LSD + LBD timed as the reference.
   const bool kitti = ds->format() == io::DatasetFormat::kKitti;
-  features::LineBenchmarkOptions lo;
+  bench::LineBenchmarkOptions lo;
   lo.extractor = kitti ? features::LineExtractorOptions::kitti() : features::LineExtractorOptions::euroc();
   // As the SLAM front end keeps them: only lines steep enough for stereo compete for the N places.
   lo.extractor.min_angle_from_horizontal_deg = lo.stereo.min_angle_from_horizontal_deg;
   lo.stop = stop;
-  if (!app::stop_requested()) j.update(features::benchmark_lines(*ds, 0, lo));
+  if (!app::stop_requested()) j.update(bench::benchmark_lines(*ds, 0, lo));
   if (!app::stop_requested()) j["frame_ms"] = frame_benchmark(*ds, kitti);
   const bool interrupted = app::stop_requested();
   if (interrupted) {

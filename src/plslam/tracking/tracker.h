@@ -122,14 +122,12 @@ class Tracker {
   // map (call before the first frame).
   void start_in_loaded_map();
 
-  TrackingState state() const { return state_; }
   int lost_events() const { return lost_events_; }
   const std::vector<long>& relocalized_frames() const { return relocalized_frames_; }
   const std::vector<long>& new_segment_frames() const { return new_segment_frames_; }
   const std::vector<FrameRecord>& records() const { return records_; }
   // The pose of a record with every keyframe's current estimate (call with local mapping idle).
   static geometry::SE3 pose_of(const FrameRecord& r);
-  const Frame* last_frame() const { return last_ ? &*last_ : nullptr; }
 
  private:
   bool initialize(Frame& f);

@@ -15,10 +15,10 @@
 #include "plslam/io/dataset.h"
 #include "plslam/matching/stereo_line_matcher.h"
 
-namespace plslam::features {
+namespace plslam::bench {
 
 struct LineBenchmarkOptions {
-  LineExtractorOptions extractor;  // kind is forced to kGrow for the fast path
+  features::LineExtractorOptions extractor;  // kind is forced to kGrow for the fast path
   matching::StereoLineMatchOptions stereo;
   bool reference = true;  // also time OpenCV LSD (full resolution) and OpenCV LBD
   // Polled before loading each frame after the first: true measures only the frames loaded so far.
@@ -30,7 +30,8 @@ struct LineBenchmarkOptions {
 // lines_detected, lines_after_merge, lines_kept, stereo_line_matches; plus frames and
 // lines_speedup_vs_opencv (median OpenCV LSD + LBD over median lines_image_ms).
 // Our segments as OpenCV KeyLines (octave 0), to run OpenCV's LBD on exactly the same lines.
-std::vector<cv::line_descriptor::KeyLine> to_keylines(const std::vector<LineSegment>& lines, cv::Size image_size);
+std::vector<cv::line_descriptor::KeyLine> to_keylines(const std::vector<features::LineSegment>& lines,
+                                                      cv::Size image_size);
 
 nlohmann::json benchmark_lines(const std::vector<std::pair<cv::Mat, cv::Mat>>& stereo_frames,
                                const StereoCalibration& calib, const LineBenchmarkOptions& options = {});
@@ -39,4 +40,4 @@ nlohmann::json benchmark_lines(const std::vector<std::pair<cv::Mat, cv::Mat>>& s
 nlohmann::json benchmark_lines(const io::Dataset& dataset, std::size_t frames,
                                const LineBenchmarkOptions& options = {});
 
-}  // namespace plslam::features
+}  // namespace plslam::bench

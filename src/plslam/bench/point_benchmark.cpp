@@ -1,4 +1,4 @@
-#include "plslam/features/point_benchmark.h"
+#include "plslam/bench/point_benchmark.h"
 
 #include "plslam/core/sample_stats.h"
 
@@ -13,7 +13,7 @@
 #include "plslam/features/keypoint_uniformity.h"
 #include "plslam/matching/stereo_point_frame.h"
 
-namespace plslam::features {
+namespace plslam::bench {
 namespace {
 
 // Thread CPU time: the machine may be shared, and the stages are single-threaded, so CPU time is
@@ -29,11 +29,11 @@ struct ThreadCpuClock {
 double cpu_ms_since(double t0) { return ThreadCpuClock::now() - t0; }
 
 // Level-0 positions of distributed candidates, for the uniformity score.
-std::vector<cv::KeyPoint> to_level0(const PyramidCandidates& kept, const ImagePyramid& pyramid) {
+std::vector<cv::KeyPoint> to_level0(const features::PyramidCandidates& kept, const features::ImagePyramid& pyramid) {
   std::vector<cv::KeyPoint> out;
   for (std::size_t l = 0; l < kept.size(); ++l) {
     const int level = static_cast<int>(l);
-    const FastCorners& c = kept[l].corners;
+    const features::FastCorners& c = kept[l].corners;
     for (std::size_t i = 0; i < c.size(); ++i) {
       cv::KeyPoint p = c.keypoint(i);
       p.pt = {pyramid.from_level_x(p.pt.x + static_cast<float>(kept[l].offset.x), level),
@@ -45,7 +45,7 @@ std::vector<cv::KeyPoint> to_level0(const PyramidCandidates& kept, const ImagePy
   return out;
 }
 
-int count(const PyramidCandidates& c) {
+int count(const features::PyramidCandidates& c) {
   int n = 0;
   for (const auto& lc : c) n += static_cast<int>(lc.corners.size());
   return n;
@@ -66,11 +66,11 @@ class SingleThreadedOpenCv {
 }  // namespace
 
 nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchmarkOptions& options) {
-  OrbOptions orb = options.orb;
+  features::OrbOptions orb = options.orb;
   orb.n_features = options.n_features > 0 ? options.n_features
                                           : (dataset.format() == io::DatasetFormat::kKitti ? 2000 : 1200);
-  const OrbExtractor left_extractor(orb);
-  const OrbExtractor right_extractor(matching::right_image_options(orb, options.right_feature_factor));
+  const features::OrbExtractor left_extractor(orb);
+  const features::OrbExtractor right_extractor(matching::right_image_options(orb, options.right_feature_factor));
   matching::StereoPointOptions stereo;
   stereo.bf = dataset.calibration().bf();
   stereo.baseline = dataset.calibration().baseline;
@@ -86,27 +86,27 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
     size = frame.left.size();
     // The first frame runs twice: the first pass only warms caches and allocations.
     for (int pass = (i == 0 ? 0 : 1); pass < 2; ++pass) {
-      PointFeatures left;
+      features::PointFeatures left;
       auto t0 = ThreadCpuClock::now();
       left_extractor.build_pyramid(frame.left, left.pyramid);
       const double t_pyr = cpu_ms_since(t0);
       t0 = ThreadCpuClock::now();
-      const PyramidCandidates cand = left_extractor.detect(left.pyramid);
+      const features::PyramidCandidates cand = left_extractor.detect(left.pyramid);
       const double t_fast = cpu_ms_since(t0);
       // SSC and quadtree on the same candidates, `distribution_repeats` times each with the order
       // alternating (whichever runs second finds the candidates in cache); the frame's time for
       // each is the median of its repeats, so that one interrupted run does not decide a ratio
       // of two sub-millisecond stages.
-      PyramidCandidates ssc, quad;
+      features::PyramidCandidates ssc, quad;
       std::vector<double> ssc_reps, quad_reps;
       auto run_ssc = [&] {
         const auto t = ThreadCpuClock::now();
-        ssc = left_extractor.distribute(cand, Distribution::kSsc);
+        ssc = left_extractor.distribute(cand, features::Distribution::kSsc);
         ssc_reps.push_back(cpu_ms_since(t));
       };
       auto run_quadtree = [&] {
         const auto t = ThreadCpuClock::now();
-        quad = left_extractor.distribute(cand, Distribution::kQuadtree);
+        quad = left_extractor.distribute(cand, features::Distribution::kQuadtree);
         quad_reps.push_back(cpu_ms_since(t));
       };
       const int repeats = std::max(1, options.distribution_repeats);
@@ -124,7 +124,7 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
       left_extractor.describe(left.pyramid, ssc, left);
       const double t_orb = cpu_ms_since(t0);
       t0 = ThreadCpuClock::now();
-      const PointFeatures right = right_extractor.extract(frame.right);
+      const features::PointFeatures right = right_extractor.extract(frame.right);
       const double t_right = cpu_ms_since(t0);
       t0 = ThreadCpuClock::now();
       const matching::StereoPointMatches m = matching::match_stereo_points(left, right, stereo);
@@ -145,8 +145,8 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
       kept_quadtree.push_back(count(quad));
       matches.push_back(m.matched);
       match_share.push_back(left.keypoints.empty() ? 0.0 : static_cast<double>(m.matched) / static_cast<double>(left.keypoints.size()));
-      cv_ssc.push_back(grid_count_cv(to_level0(ssc, left.pyramid), size));
-      cv_quadtree.push_back(grid_count_cv(to_level0(quad, left.pyramid), size));
+      cv_ssc.push_back(features::grid_count_cv(to_level0(ssc, left.pyramid), size));
+      cv_quadtree.push_back(features::grid_count_cv(to_level0(quad, left.pyramid), size));
     }
   }
 
@@ -196,4 +196,4 @@ nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchm
   return j;
 }
 
-}  // namespace plslam::features
+}  // namespace plslam::bench

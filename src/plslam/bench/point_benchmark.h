@@ -10,13 +10,13 @@
 #include "plslam/features/orb_extractor.h"
 #include "plslam/io/dataset.h"
 
-namespace plslam::features {
+namespace plslam::bench {
 
 struct PointBenchmarkOptions {
   std::size_t max_frames = 0;     // 0: every frame of the dataset
   int distribution_repeats = 5;   // SSC and quadtree timings per frame: median of this many runs
   int n_features = 0;             // 0: 1200 for EuRoC, 2000 for KITTI
-  OrbOptions orb;                 // n_features is overridden as above
+  features::OrbOptions orb;                 // n_features is overridden as above
   double right_feature_factor = 2.0;
   // Polled before each frame after the first: true ends the benchmark with the frames measured
   // so far (a signal asked the program to stop).
@@ -29,4 +29,4 @@ struct PointBenchmarkOptions {
 nlohmann::json run_point_benchmark(const io::Dataset& dataset, const PointBenchmarkOptions& options);
 
 
-}  // namespace plslam::features
+}  // namespace plslam::bench

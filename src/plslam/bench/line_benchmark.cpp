@@ -1,4 +1,4 @@
-#include "plslam/features/line_benchmark.h"
+#include "plslam/bench/line_benchmark.h"
 
 #include "plslam/core/stopwatch.h"
 
@@ -11,13 +11,14 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/line_descriptor.hpp>
 
-namespace plslam::features {
+namespace plslam::bench {
 
-std::vector<cv::line_descriptor::KeyLine> to_keylines(const std::vector<LineSegment>& lines, cv::Size image_size) {
+std::vector<cv::line_descriptor::KeyLine> to_keylines(const std::vector<features::LineSegment>& lines,
+                                                      cv::Size image_size) {
   std::vector<cv::line_descriptor::KeyLine> kls;
   kls.reserve(lines.size());
   for (std::size_t i = 0; i < lines.size(); ++i) {
-    const LineSegment& s = lines[i];
+    const features::LineSegment& s = lines[i];
     cv::line_descriptor::KeyLine k;
     k.startPointX = k.sPointInOctaveX = s.start.x;
     k.startPointY = k.sPointInOctaveY = s.start.y;
@@ -38,7 +39,7 @@ std::vector<cv::line_descriptor::KeyLine> to_keylines(const std::vector<LineSegm
 namespace {
 
 // OpenCV's binary LBD on our segments, for the cost comparison.
-double opencv_lbd_ms(const cv::Mat& grey, const std::vector<LineSegment>& lines) {
+double opencv_lbd_ms(const cv::Mat& grey, const std::vector<features::LineSegment>& lines) {
   std::vector<cv::line_descriptor::KeyLine> kls = to_keylines(lines, grey.size());
   auto bd = cv::line_descriptor::BinaryDescriptor::createBinaryDescriptor();
   cv::Mat desc;
@@ -53,8 +54,8 @@ nlohmann::json benchmark_lines(const std::vector<std::pair<cv::Mat, cv::Mat>>& f
                                const LineBenchmarkOptions& o) {
   if (frames.empty()) throw std::invalid_argument("benchmark_lines: no frames");
   std::vector<double> lsd, fast, merge, lbd, image, cv_lbd, stereo, detected, merged, kept, matches;
-  LineExtractorOptions fast_opts = o.extractor;
-  fast_opts.detector.kind = LineDetectorKind::kGrow;
+  features::LineExtractorOptions fast_opts = o.extractor;
+  fast_opts.detector.kind = features::LineDetectorKind::kGrow;
   for (const auto& [left, right] : frames) {
     if (o.reference) {
       // OpenCV's own LSD alone (default parameters, no refinement), full resolution.
@@ -64,10 +65,10 @@ nlohmann::json benchmark_lines(const std::vector<std::pair<cv::Mat, cv::Mat>>& f
       detector->detect(left, raw);
       lsd.push_back(ms_since(t0));
     }
-    LineTimings tl, tr;
-    const LineFeatures fl = extract_lines(left, fast_opts, &tl);
-    const LineFeatures fr = extract_lines(right, fast_opts, &tr);
-    for (const LineTimings* t : {&tl, &tr}) {
+    features::LineTimings tl, tr;
+    const features::LineFeatures fl = features::extract_lines(left, fast_opts, &tl);
+    const features::LineFeatures fr = features::extract_lines(right, fast_opts, &tr);
+    for (const features::LineTimings* t : {&tl, &tr}) {
       fast.push_back(t->detect_ms);
       merge.push_back(t->merge_ms);
       lbd.push_back(t->describe_ms);
@@ -113,4 +114,4 @@ nlohmann::json benchmark_lines(const io::Dataset& dataset, std::size_t n, const 
   return benchmark_lines(frames, dataset.calibration(), o);
 }
 
-}  // namespace plslam::features
+}  // namespace plslam::bench

@@ -2,11 +2,11 @@
 #include <gtest/gtest.h>
 
 #include "features/line_synthetic_scene.h"
-#include "plslam/features/line_benchmark.h"
+#include "plslam/bench/line_benchmark.h"
 #include "plslam/io/dataset.h"
 #include "support/test_support.h"
 
-namespace plslam::features {
+namespace plslam::bench {
 namespace {
 
 TEST(LineBenchmark, ReportsAllKeysOnSyntheticFrames) {
@@ -27,9 +27,9 @@ TEST(LineBenchmark, ReportsAllKeysOnSyntheticFrames) {
 }
 
 }  // namespace
-}  // namespace plslam::features
+}  // namespace plslam::bench
 
-namespace plslam::features {
+namespace plslam::bench {
 namespace {
 
 TEST(LineBenchmark, RealSequencesThroughDatasetReader) {
@@ -37,7 +37,7 @@ TEST(LineBenchmark, RealSequencesThroughDatasetReader) {
   io::DatasetOptions d;
   d.max_frames = 3;
   LineBenchmarkOptions kitti;
-  kitti.extractor = LineExtractorOptions::kitti();
+  kitti.extractor = features::LineExtractorOptions::kitti();
   kitti.reference = false;
   const auto jk = benchmark_lines(*io::open_dataset(data / "kitti/sequences/06", d), 0, kitti);
   EXPECT_EQ(jk["frames"].get<int>(), 3);
@@ -52,4 +52,4 @@ TEST(LineBenchmark, RealSequencesThroughDatasetReader) {
 }
 
 }  // namespace
-}  // namespace plslam::features
+}  // namespace plslam::bench

@@ -1,0 +1,3 @@
+#include "plslam/beta/beta.h"
+
+#include "plslam/alpha/alpha.h"

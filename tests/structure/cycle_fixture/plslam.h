@@ -1,0 +1,3 @@
+#pragma once
+#include "plslam/alpha/alpha.h"
+#include "plslam/gamma/gamma.inc"
