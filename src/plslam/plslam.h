@@ -80,6 +80,9 @@ struct MapSnapshot {
   Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> lines;   // x y z of both endpoints
   std::vector<long> point_ids, line_ids;
   Trajectory keyframes;  // T_world_camera of every keyframe, by time
+  // The map's change counter when the copy was taken: Slam::map_changes() differs once the map
+  // has changed (a viewer copies it again only then).
+  long changes = 0;
 };
 
 struct SlamStats {
@@ -148,7 +151,9 @@ class Slam {
   // Every tracked frame with the map's current estimate of it (keyframes move under bundle
   // adjustment and loop closing, and frames move with them).
   Trajectory trajectory() const;
+  // A consistent copy (no optimisation is seen half written back); safe while the threads run.
   MapSnapshot map() const;
+  long map_changes() const;
   SlamStats stats() const;
   const StereoCalibration& calibration() const;
 

@@ -8,6 +8,7 @@ namespace plslam::map {
 
 KeyFrame* Map::create_keyframe(std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw) {
   std::lock_guard lock(mutex_);
+  ++changes_;
   all_keyframes_.push_back(std::make_unique<KeyFrame>(next_keyframe_id_++, std::move(data), T_cw));
   keyframes_.insert(all_keyframes_.back().get());
   return all_keyframes_.back().get();
@@ -15,6 +16,7 @@ KeyFrame* Map::create_keyframe(std::shared_ptr<const FrameData> data, const geom
 
 MapPoint* Map::create_point(const Eigen::Vector3d& position, KeyFrame* reference, long frame_id) {
   std::lock_guard lock(mutex_);
+  ++changes_;
   all_points_.push_back(std::make_unique<MapPoint>(next_point_id_++, position, reference, frame_id));
   points_.insert(all_points_.back().get());
   return all_points_.back().get();
@@ -23,6 +25,7 @@ MapPoint* Map::create_point(const Eigen::Vector3d& position, KeyFrame* reference
 MapLine* Map::create_line(const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
                           long frame_id) {
   std::lock_guard lock(mutex_);
+  ++changes_;
   all_lines_.push_back(std::make_unique<MapLine>(next_line_id_++, start, end, reference, frame_id));
   lines_.insert(all_lines_.back().get());
   return all_lines_.back().get();
@@ -30,6 +33,7 @@ MapLine* Map::create_line(const Eigen::Vector3d& start, const Eigen::Vector3d& e
 
 KeyFrame* Map::restore_keyframe(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw) {
   std::lock_guard lock(mutex_);
+  ++changes_;
   if (id < 0) throw std::invalid_argument("negative keyframe id");
   all_keyframes_.push_back(std::make_unique<KeyFrame>(id, std::move(data), T_cw));
   if (!keyframes_.insert(all_keyframes_.back().get()).second) {
@@ -42,6 +46,7 @@ KeyFrame* Map::restore_keyframe(long id, std::shared_ptr<const FrameData> data, 
 
 MapPoint* Map::restore_point(long id, const Eigen::Vector3d& position, KeyFrame* reference, long frame_id) {
   std::lock_guard lock(mutex_);
+  ++changes_;
   if (id < 0) throw std::invalid_argument("negative point id");
   all_points_.push_back(std::make_unique<MapPoint>(id, position, reference, frame_id));
   if (!points_.insert(all_points_.back().get()).second) {
@@ -55,6 +60,7 @@ MapPoint* Map::restore_point(long id, const Eigen::Vector3d& position, KeyFrame*
 MapLine* Map::restore_line(long id, const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
                            long frame_id) {
   std::lock_guard lock(mutex_);
+  ++changes_;
   if (id < 0) throw std::invalid_argument("negative line id");
   all_lines_.push_back(std::make_unique<MapLine>(id, start, end, reference, frame_id));
   if (!lines_.insert(all_lines_.back().get()).second) {
@@ -79,16 +85,19 @@ void Map::restore_next_ids(const NextIds& next) {
 
 void Map::erase_keyframe(KeyFrame* kf) {
   std::lock_guard lock(mutex_);
+  ++changes_;
   keyframes_.erase(kf);
 }
 
 void Map::erase_point(MapPoint* p) {
   std::lock_guard lock(mutex_);
+  ++changes_;
   points_.erase(p);
 }
 
 void Map::erase_line(MapLine* l) {
   std::lock_guard lock(mutex_);
+  ++changes_;
   lines_.erase(l);
 }
 

@@ -53,17 +53,27 @@ class Map {
 
   // Held by whoever changes poses or structure wholesale (local BA write-back) and by tracking
   // while it reads them, so that tracking never sees half an update (ORB-SLAM2's mMutexMapUpdate).
-  std::mutex& update_mutex() { return update_mutex_; }
+  std::mutex& update_mutex() const { return update_mutex_; }
   // Counts wholesale changes of the map's geometry (a loop correction, a global BA merge): every
   // keyframe may have moved, so whoever keeps a pose across frames (the tracker's last frame)
   // re-expresses it through its reference keyframe when the count changed.
   long big_changes() const { return big_changes_.load(); }
-  void note_big_change() { ++big_changes_; }
+  void note_big_change() {
+    ++big_changes_;
+    ++changes_;
+  }
+  // Counts every change a reader outside the SLAM threads may want to redraw or rewrite: objects
+  // created, restored or erased, poses and positions moved by an optimisation (note_change() by
+  // whoever writes them back), and the big changes. A viewer takes a new snapshot
+  // (map/map_snapshot.h) only when it differs from the snapshot's.
+  long changes() const { return changes_.load(); }
+  void note_change() { ++changes_; }
 
  private:
   mutable std::mutex mutex_;
-  std::mutex update_mutex_;
+  mutable std::mutex update_mutex_;
   std::atomic<long> big_changes_{0};
+  std::atomic<long> changes_{0};
   std::vector<std::unique_ptr<KeyFrame>> all_keyframes_;
   std::vector<std::unique_ptr<MapPoint>> all_points_;
   std::vector<std::unique_ptr<MapLine>> all_lines_;

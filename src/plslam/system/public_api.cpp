@@ -1,4 +1,5 @@
 // plslam::Slam (plslam/plslam.h): the public API over system::System.
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
@@ -10,6 +11,7 @@
 #include "plslam/eval/evaluate.h"
 #include "plslam/io/calibration_file.h"
 #include "plslam/io/dataset.h"
+#include "plslam/map/map_snapshot.h"
 #include "plslam/plslam.h"
 #include "plslam/system/map_file.h"
 #include "plslam/system/slam_system.h"
@@ -199,27 +201,27 @@ TrackedFrame Slam::track(const cv::Mat& left, const cv::Mat& right, double times
 Trajectory Slam::trajectory() const { return impl_->slam->tracked_trajectory(); }
 
 MapSnapshot Slam::map() const {
-  const auto& m = impl_->slam->map();
+  const auto snap = map::take_snapshot(impl_->slam->map());
   MapSnapshot s;
-  // Landmarks stay allocated until the map is destroyed (culled ones are only unlisted), and each
-  // guards its own state, so reading them while local mapping runs is safe.
-  const auto points = m.points();
-  s.points.resize(static_cast<Eigen::Index>(points.size()), 3);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    s.points.row(static_cast<Eigen::Index>(i)) = points[i]->position().transpose();
-    s.point_ids.push_back(points[i]->id());
+  s.points.resize(static_cast<Eigen::Index>(snap.points.size()), 3);
+  for (std::size_t i = 0; i < snap.points.size(); ++i) {
+    s.points.row(static_cast<Eigen::Index>(i)) = snap.points[i].position.transpose();
+    s.point_ids.push_back(snap.points[i].id);
   }
-  const auto lines = m.lines();
-  s.lines.resize(static_cast<Eigen::Index>(lines.size()), 6);
-  for (std::size_t i = 0; i < lines.size(); ++i) {
+  s.lines.resize(static_cast<Eigen::Index>(snap.lines.size()), 6);
+  for (std::size_t i = 0; i < snap.lines.size(); ++i) {
     const auto row = static_cast<Eigen::Index>(i);
-    s.lines.block<1, 3>(row, 0) = lines[i]->start().transpose();
-    s.lines.block<1, 3>(row, 3) = lines[i]->end().transpose();
-    s.line_ids.push_back(lines[i]->id());
+    s.lines.block<1, 3>(row, 0) = snap.lines[i].start.transpose();
+    s.lines.block<1, 3>(row, 3) = snap.lines[i].end.transpose();
+    s.line_ids.push_back(snap.lines[i].id);
   }
-  s.keyframes = impl_->slam->keyframe_trajectory();
+  for (const auto& kf : snap.keyframes) s.keyframes.push_back({kf.timestamp, kf.T_wc.isometry()});
+  std::sort(s.keyframes.begin(), s.keyframes.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
+  s.changes = snap.changes;
   return s;
 }
+
+long Slam::map_changes() const { return impl_->slam->map().changes(); }
 
 SlamStats Slam::stats() const {
   const auto& sys = *impl_->slam;

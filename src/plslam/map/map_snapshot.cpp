@@ -1,0 +1,25 @@
+#include "plslam/map/map_snapshot.h"
+
+#include <mutex>
+
+namespace plslam::map {
+
+MapSnapshot take_snapshot(const Map& map) {
+  std::lock_guard lock(map.update_mutex());
+  MapSnapshot s;
+  s.changes = map.changes();
+  for (const auto* kf : map.keyframes()) {
+    KeyframeSnapshot k;
+    k.id = kf->id();
+    k.timestamp = kf->timestamp();
+    k.T_wc = kf->pose_inverse();
+    if (const auto* parent = kf->parent()) k.parent = parent->id();
+    for (const auto* other : kf->loop_edges()) k.loop_edges.push_back(other->id());
+    s.keyframes.push_back(std::move(k));
+  }
+  for (const auto* p : map.points()) s.points.push_back({p->id(), p->position()});
+  for (const auto* l : map.lines()) s.lines.push_back({l->id(), l->start(), l->end()});
+  return s;
+}
+
+}  // namespace plslam::map
