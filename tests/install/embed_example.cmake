@@ -44,8 +44,9 @@ run(${prefix}/bin/plslam synth --out ${WORK_DIR}/office --scene office --preset 
 run(${CMAKE_COMMAND} -E env PLSLAM_DATA_DIR=${prefix}/share/plslam
     ${WORK_DIR}/embed-build/embed ${WORK_DIR}/office ${WORK_DIR}/embed.tum)
 message(STATUS "embed: ${run_output}")
-if(NOT run_output MATCHES "frames ([0-9]+) tracked ([0-9]+) .* ate_rmse_m ([0-9.]+)")
-  message(FATAL_ERROR "embed printed no summary: ${run_output}")
+# Its stdout is its own: the summary line only (the library logs to stderr).
+if(NOT run_output MATCHES "^frames ([0-9]+) tracked ([0-9]+) [^\n]* ate_rmse_m ([0-9.]+)\n$")
+  message(FATAL_ERROR "embed printed more or less than its summary on stdout: ${run_output}")
 endif()
 set(frames ${CMAKE_MATCH_1})
 set(tracked ${CMAKE_MATCH_2})

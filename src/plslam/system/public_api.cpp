@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "plslam/core/log.h"
 #include "plslam/core/version.h"
 #include "plslam/eval/evaluate.h"
 #include "plslam/io/calibration_file.h"
@@ -134,6 +135,9 @@ TrajectoryErrors evaluate_trajectory(const Trajectory& ground_truth, const Traje
 
 struct Slam::Impl {
   Impl(const StereoCalibration& c, const SlamOptions& o) : calib(c), options(o) {
+    // spdlog's own default logger writes to stdout, which belongs to the embedding program: unless
+    // the program installed a logger of its own, plslam's messages go to stderr.
+    if (spdlog::default_logger()->name().empty()) init_logging(LogLevel::kInfo);
     check_calibration(c);
     const auto sys_options = system_options(o);
     vocabulary = system::load_vocabulary(sys_options);
