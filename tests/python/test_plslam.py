@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -100,8 +101,11 @@ def test_tracking_releases_the_gil(office_short):
     stop = threading.Event()
 
     def spin():
+        # It sleeps between counts, so it hands the GIL back at once when track() wants it again
+        # (a busy loop would keep it for the whole switch interval).
         while not stop.is_set():
             count[0] += 1
+            time.sleep(0.0002)
 
     old = sys.getswitchinterval()
     sys.setswitchinterval(100.0)
