@@ -121,6 +121,11 @@ TEST(VideoRobustness, AMissingCameraIsOneLineAndExit2) {
   expect_refused("--camera /dev/video97" + calib, out, {"/dev/video97: no such device"});
   expect_refused("--camera /dev/video97 --camera-right /dev/video98" + calib, out, {"/dev/video97: no such device"});
   expect_refused("--camera /dev/null" + calib, out, {"/dev/null: cannot open it as a V4L2 camera"});
+  // A file in place of the device is a video played as a camera: it must be one, holding both images.
+  expect_refused("--camera " + q(v / "calibration.yaml") + calib, out,
+                 {(v / "calibration.yaml").string(), "not a video FFmpeg can decode"});
+  expect_refused("--camera " + q(v / "stereo.mkv") + " --camera-right /dev/video98" + calib, out,
+                 {"/dev/video98: a video file played as a camera holds both images"});
   expect_refused("--camera /dev/video97", out, {"--video and --camera need --calib FILE"});
   expect_refused("--camera /dev/video97 --start 3" + calib, out, {"--start is not for a live camera"});
   const auto r = test::run_cli("run --camera /dev/video97 --realtime --out " + q(out) + calib);

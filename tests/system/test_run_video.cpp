@@ -66,5 +66,39 @@ TEST(RunVideo, ASyntheticVideoTracksLikeItsImageFolders) {
   EXPECT_LT(ate_video, 0.02);
 }
 
+// The live path end to end, without a camera: a video file given to --camera is played at its
+// frame rate (100 Hz here, faster than tracking), so the capture drops the frames tracking has no
+// time for, counts them, and the run still tracks what it takes.
+TEST(RunVideo, AVideoPlayedAsACameraDropsWhatTrackingHasNoTimeFor) {
+  test::TempDir tmp;
+  constexpr int kFrames = 60;
+  const auto video = tmp.path() / "video";
+  auto r = test::run_cli("synth --out " + q(video) + " --scene office --frames " + std::to_string(kFrames) +
+                         " --seed 3 --fps 100 --format video");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto out = tmp.path() / "live";
+  r = test::run_cli("run --camera " + q(video / "stereo.mkv") + " --calib " + q(video / "calibration.yaml") +
+                    " --out " + q(out));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("dropped (tracking was busy"), std::string::npos) << r.err;
+  const auto stats = read_json(out / "stats.json");
+  const auto& live = stats["live"];
+  ASSERT_TRUE(live.is_object()) << stats;
+  EXPECT_EQ(live["source"], (video / "stereo.mkv").string());
+  EXPECT_EQ(live["captured"], kFrames);
+  EXPECT_EQ(stats["input_frames"], kFrames);
+  EXPECT_EQ(stats["complete"], true);
+  EXPECT_EQ(stats["interrupted_by"], nullptr);
+  // Every frame was taken or dropped (the last one is always taken), and tracking had no time for
+  // most of them at 100 Hz.
+  EXPECT_EQ(live["taken"].get<int>() + live["dropped"].get<int>(), kFrames);
+  EXPECT_GT(live["dropped"].get<int>(), 0);
+  EXPECT_EQ(stats["frames"], live["taken"]);
+  EXPECT_EQ(stats["tracked_frames"], live["taken"]);
+  EXPECT_FALSE(fs::exists(out / "trajectory.kitti"));
+  // No ground truth for a camera.
+  EXPECT_FALSE(stats.contains("accuracy"));
+}
+
 }  // namespace run_video_test
 }  // namespace plslam

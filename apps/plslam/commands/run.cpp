@@ -98,7 +98,7 @@ RunInput open_input(const RunArgs& args) {
   RunInput in;
   if (!args.camera.empty()) {
     in.calibration = io::read_calibration_file(args.calib);
-    in.camera = io::open_v4l2_stereo_camera(args.camera, args.camera_right, in.calibration);
+    in.camera = io::open_stereo_camera(args.camera, args.camera_right, in.calibration);
     in.name = in.camera->name();
     return in;
   }
@@ -415,7 +415,8 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                                           "dataset folder; a ground_truth.tum beside it is used");
                            auto* camera = sub.add_option("--camera", args->camera,
                                                          "Live V4L2 camera, e.g. /dev/video0: side-by-side frames, "
-                                                         "or the left camera with --camera-right");
+                                                         "or the left camera with --camera-right (a video file is "
+                                                         "played at its frame rate, as a camera would deliver it)");
                            sub.add_option("--camera-right", args->camera_right, "The right camera's device")
                                ->needs(camera);
                            sub.add_option("--calib", args->calib,

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <thread>
 
 #include <fmt/format.h>
 #include <opencv2/videoio.hpp>
@@ -71,10 +72,54 @@ class V4l2StereoCamera final : public FrameSource {
   std::chrono::steady_clock::time_point start_;
 };
 
+// A video file replayed in real time: frame i is delivered at its time i / fps after the first
+// capture() call, whether or not anybody takes it.
+class VideoFileCamera final : public FrameSource {
+ public:
+  VideoFileCamera(const std::string& file, const StereoCalibration& c) : file_(file), width_(c.width), height_(c.height) {
+    quiet_ffmpeg_log();
+    if (!capture_.open(file, cv::CAP_FFMPEG)) throw InputError(file, "not a video FFmpeg can decode");
+    fps_ = capture_.get(cv::CAP_PROP_FPS);
+    if (!(fps_ > 0 && fps_ <= 1000)) fps_ = 30.0;
+    cv::Mat frame;
+    if (!capture_.read(frame)) throw InputError(file, "no frame decodes");
+    cv::Mat left, right;
+    split_side_by_side(frame, width_, height_, file_, left, right);
+    capture_.open(file, cv::CAP_FFMPEG);  // back to the first frame
+  }
+
+  std::optional<CapturedFrame> capture() override {
+    const auto now = std::chrono::steady_clock::now();
+    if (index_ == 0) start_ = now;
+    std::this_thread::sleep_until(start_ + std::chrono::duration<double>(static_cast<double>(index_) / fps_));
+    cv::Mat frame;
+    if (!capture_.read(frame)) return std::nullopt;  // the end of the video ends the "camera"
+    CapturedFrame f;
+    f.timestamp = static_cast<double>(index_++) / fps_;
+    split_side_by_side(frame, width_, height_, file_, f.left, f.right);
+    return f;
+  }
+
+  std::string name() const override { return file_; }
+
+ private:
+  std::string file_;
+  int width_, height_;
+  double fps_ = 30.0;
+  cv::VideoCapture capture_;
+  std::size_t index_ = 0;
+  std::chrono::steady_clock::time_point start_;
+};
+
 }  // namespace
 
-std::unique_ptr<FrameSource> open_v4l2_stereo_camera(const std::string& device, const std::string& right_device,
+std::unique_ptr<FrameSource> open_stereo_camera(const std::string& device, const std::string& right_device,
                                                      const StereoCalibration& calibration) {
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(device, ec)) {
+    if (!right_device.empty()) throw InputError(right_device, "a video file played as a camera holds both images");
+    return std::make_unique<VideoFileCamera>(device, calibration);
+  }
   return std::make_unique<V4l2StereoCamera>(device, right_device, calibration);
 }
 
