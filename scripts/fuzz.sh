@@ -5,7 +5,7 @@
 #   scripts/fuzz.sh [--minutes N | --seconds S] [target...]   default: 5 minutes each, every target
 #
 # Targets (tests/fuzz/targets): config trajectory euroc_sensor euroc_data_csv euroc_groundtruth
-# kitti_calib kitti_times frame_log image vocabulary bench_configs map_file. Each starts from tests/fuzz/corpus/<target>/ (the
+# kitti_calib kitti_times frame_log image vocabulary bench_configs map_file calibration_file. Each starts from tests/fuzz/corpus/<target>/ (the
 # checked-in seeds) and keeps what it learns in build-fuzz/corpus/<target>/; crashes are written
 # to build-fuzz/crashes/<target>/. A crash input belongs in tests/fuzz/corpus/<target>/ once the
 # bug is fixed: the ctest FuzzReplay.* replays every corpus file in every build.
@@ -28,7 +28,7 @@ case "$seconds" in
   ''|*[!0-9]*|0) echo "fuzz.sh: the time per target must be a positive whole number of seconds" >&2; exit 2 ;;
 esac
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(config trajectory euroc_sensor euroc_data_csv euroc_groundtruth kitti_calib kitti_times frame_log image vocabulary bench_configs map_file)
+  targets=(config trajectory euroc_sensor euroc_data_csv euroc_groundtruth kitti_calib kitti_times frame_log image vocabulary bench_configs map_file calibration_file)
 fi
 
 BUILD_DIR=${BUILD_DIR:-build-fuzz}

@@ -33,8 +33,8 @@ class System;
 const char* version();
 
 // Reads a stereo calibration file (YAML: width, height, fx, fy, cx, cy, baseline of the rectified
-// pair; README "Calibration"). InputError naming the file and key on a missing file, a missing or
-// unknown key, or a value that is not positive and finite.
+// pair; README "Video and camera input"). InputError naming the file and key on a missing file, a
+// missing or unknown key, or a value that is not positive and finite.
 StereoCalibration read_calibration(const std::filesystem::path& file);
 
 // The defaults a preset holds: EuRoC-like (20 Hz, 752x480, 11 cm baseline) or KITTI-like

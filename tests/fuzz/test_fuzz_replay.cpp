@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "fuzz/targets/fuzz_bench_configs.cpp"
+#include "fuzz/targets/fuzz_calibration_file.cpp"
 #include "fuzz/targets/fuzz_config.cpp"
 #include "fuzz/targets/fuzz_datasets.cpp"
 #include "fuzz/targets/fuzz_euroc_sensor.cpp"
@@ -42,6 +43,7 @@ const Target kTargets[] = {
     {"map_file", fuzz_map_file},
     {"vocabulary", fuzz_vocabulary},
     {"bench_configs", fuzz_bench_configs},
+    {"calibration_file", fuzz_calibration_file},
 };
 
 class FuzzReplay : public testing::TestWithParam<Target> {};

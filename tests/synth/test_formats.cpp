@@ -9,7 +9,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "plslam/io/calibration_file.h"
 #include "plslam/io/dataset.h"
+#include "plslam/io/video_dataset.h"
 #include "plslam/io/trajectory_io.h"
 #include "plslam/synth/writer.h"
 #include "support/test_support.h"
@@ -173,6 +175,38 @@ TEST(SynthFormats, Euroc) {
   const double diff = cv::norm(frame.left, raw, cv::NORM_L1) / raw.total();
   std::printf("reader-rectified vs written left image: mean |diff| %.4f grey levels\n", diff);
   EXPECT_LT(diff, 0.5);
+}
+
+// The video layout: a lossless side-by-side video, read back through the project's video reader
+// as exactly the rendered images, with its calibration file and ground truth in the scene's world.
+// The KITTI preset's odd width (1241) and the threads' out-of-order rendering are both covered.
+TEST(SynthFormats, Video) {
+  test::TempDir tmp;
+  auto o = small(SceneKind::kStreet, kitti_preset());
+  o.frames = 21;  // more than one batch of chunks with 2 threads
+  const Sequence seq(o);
+  ASSERT_TRUE(write_sequence(seq, tmp.path(), OutputFormat::kVideo, {}, 2));
+  const auto c = io::read_calibration_file(tmp.path() / kVideoCalibrationFile);
+  EXPECT_EQ(c.width, 1241);
+  EXPECT_EQ(c.height, 376);
+  EXPECT_EQ(c.fx, 718.856);
+  EXPECT_EQ(c.baseline, 0.54);
+  const auto ds = io::open_video_dataset(tmp.path() / kVideoFile, tmp.path() / kVideoCalibrationFile);
+  ASSERT_EQ(ds->size(), 21u);
+  EXPECT_NEAR(ds->fps(), 10.0, 1e-9);
+  ASSERT_TRUE(ds->ground_truth().has_value());
+  ASSERT_EQ(ds->ground_truth()->size(), 21u);
+  StereoRenderer renderer(seq);
+  for (std::size_t i : {0u, 7u, 20u}) {
+    EXPECT_DOUBLE_EQ(ds->ground_truth()->at(i).t, ds->timestamps()[i]);
+    expect_pose_near(ds->ground_truth()->at(i).T, seq.left_pose(i), 1e-12);
+    const auto frame = ds->load(i);
+    const auto im = renderer.render(i);
+    EXPECT_EQ(cv::norm(frame.left, im.left, cv::NORM_INF), 0) << i;
+    EXPECT_EQ(cv::norm(frame.right, im.right, cv::NORM_INF), 0) << i;
+  }
+  EXPECT_TRUE(fs::is_regular_file(tmp.path() / "synth" / "synth.json"));
+  EXPECT_EQ(lines(tmp.path() / "synth" / "segments_3d.txt").size(), seq.scene().edges().size() + 1);
 }
 
 TEST(SynthFormats, CliAndInfo) {

@@ -29,11 +29,12 @@ struct DatasetArgs {
 // small enough that every count derived from it stays exact.
 inline constexpr long long kMaxFrameArg = 1'000'000'000;
 
-// `max_frames_names` lets `bench` keep its shorter "--frames" alias.
+// `max_frames_names` lets `bench` keep its shorter "--frames" alias; `run` takes other inputs
+// too, so its dataset folder is optional.
 inline void add_dataset_options(CLI::App& sub, DatasetArgs& args,
-                                const std::string& max_frames_names = "--max-frames") {
+                                const std::string& max_frames_names = "--max-frames", bool required = true) {
   sub.add_option("dataset", args.path, "Sequence folder: KITTI sequences/NN, or EuRoC <seq> or <seq>/mav0")
-      ->required();
+      ->required(required);
   sub.add_option("--format", args.format, "Dataset format")
       ->check(CLI::IsMember({"auto", "kitti", "euroc"}))
       ->capture_default_str();

@@ -18,10 +18,15 @@
 #include "plslam/core/stopwatch.h"
 #include "plslam/core/version.h"
 #include "plslam/io/atomic_file.h"
+#include "plslam/io/calibration_file.h"
+#include "plslam/io/camera_source.h"
 #include "plslam/io/frame_stream.h"
+#include "plslam/io/image_loading.h"
+#include "plslam/io/live_capture.h"
 #include "plslam/io/map_export.h"
 #include "plslam/io/output_folder.h"
 #include "plslam/io/trajectory_io.h"
+#include "plslam/io/video_dataset.h"
 #include "plslam/system/input_aligned_trajectory.h"
 #include "plslam/system/map_file.h"
 #include "plslam/system/run_report.h"
@@ -58,12 +63,57 @@ struct RunArgs {
   std::string save_map;  // --save-map FILE
   std::string load_map;  // --load-map FILE
   bool localize = false; // --localize
+  std::string video;         // --video FILE: side-by-side stereo video
+  std::string camera;        // --camera DEVICE: live V4L2 camera (side by side, or the left one)
+  std::string camera_right;  // --camera-right DEVICE
+  std::string calib;         // --calib FILE, for --video and --camera
+  std::string preset;        // --preset euroc|kitti (default: by the dataset's format)
 };
+
+// What a run reads: a dataset (KITTI or EuRoC folders, or a video file), or a live camera.
+struct RunInput {
+  std::unique_ptr<io::Dataset> dataset;  // null for a live camera
+  std::unique_ptr<io::FrameSource> camera;
+  StereoCalibration calibration;
+  io::DatasetFormat format = io::DatasetFormat::kEuroc;
+  std::string name;  // the folder, video file or device, for messages
+};
+
+// Exactly one input, and the options that belong to it (usage errors, exit 2).
+void check_input_args(const RunArgs& a) {
+  const int inputs = !a.dataset.path.empty() + !a.video.empty() + !a.camera.empty();
+  if (inputs != 1) {
+    throw InputError("", inputs == 0 ? "no input: give a dataset folder, --video FILE or --camera DEVICE"
+                                     : "give one input only: a dataset folder, --video FILE or --camera DEVICE");
+  }
+  if (a.dataset.path.empty() && a.calib.empty()) throw InputError("", "--video and --camera need --calib FILE");
+  if (!a.dataset.path.empty() && !a.calib.empty()) {
+    throw InputError("", "--calib is for --video and --camera (a dataset folder has its own calibration)");
+  }
+  if (a.dataset.path.empty() && a.dataset.format != "auto") throw InputError("", "--format is for dataset folders");
+  if (!a.camera.empty() && a.dataset.start != 0) throw InputError("", "--start is not for a live camera");
+}
+
+RunInput open_input(const RunArgs& args) {
+  RunInput in;
+  if (!args.camera.empty()) {
+    in.calibration = io::read_calibration_file(args.calib);
+    in.camera = io::open_stereo_camera(args.camera, args.camera_right, in.calibration);
+    in.name = in.camera->name();
+    return in;
+  }
+  in.dataset = args.video.empty() ? io::open_dataset(args.dataset.path, args.dataset.options())
+                                  : io::open_video_dataset(args.video, args.calib, args.dataset.options());
+  in.calibration = in.dataset->calibration();
+  in.format = in.dataset->format();
+  in.name = in.dataset->root().string();
+  return in;
+}
 
 // What a map file records as the configuration that built it: the preset, the config file's
 // text and the switches given on the command line.
-std::string map_config_text(const RunArgs& args, io::DatasetFormat format) {
-  nlohmann::json j = {{"preset", format == io::DatasetFormat::kKitti ? "kitti" : "euroc"},
+std::string map_config_text(const RunArgs& args, io::DatasetFormat preset) {
+  nlohmann::json j = {{"preset", preset == io::DatasetFormat::kKitti ? "kitti" : "euroc"},
                       {"config_file", args.config},
                       {"no_lines", args.no_lines},
                       {"no_loop_closing", args.no_loop_closing},
@@ -81,9 +131,12 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   // Checked before any frame: a bad --out must not be found only when the outputs are written.
   io::prepare_output_folder(out_dir);
   if (!args.save_map.empty()) io::prepare_output_file(args.save_map, "--save-map");
-  const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
+  RunInput input = open_input(args);
+  const io::Dataset* ds = input.dataset.get();  // null for a live camera
+  // The preset follows the dataset's format (KITTI's for KITTI, EuRoC's otherwise) unless --preset.
+  const io::DatasetFormat preset = args.preset.empty() ? input.format : io::parse_dataset_format(args.preset);
   auto options = system::load_system_options(
-      ds->format(), args.config.empty() ? std::nullopt : std::optional<fs::path>(args.config));
+      preset, args.config.empty() ? std::nullopt : std::optional<fs::path>(args.config));
   if (args.no_lines) options.disable_lines();
   options.sequential = args.sequential;
   if (!args.vocabulary.empty()) options.vocabulary = args.vocabulary;
@@ -97,16 +150,17 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   double read_ms = 0;
   if (!args.load_map.empty()) {
     loaded = system::load_map_file(args.load_map);
-    system::check_map_matches(loaded->meta, ds->calibration(), vocabulary.get(), args.load_map);
+    system::check_map_matches(loaded->meta, input.calibration, vocabulary.get(), args.load_map);
     read_ms = ms_since(load_start);
   }
 
-  spdlog::info("{}: {} frames, {}x{}, {:.1f} fps, baseline {:.3f} m, lines {}, place recognition {}", ds->root().string(),
-               ds->size(), ds->calibration().width, ds->calibration().height, ds->fps(), ds->calibration().baseline,
-               options.extractor.lines ? "on" : "off",
+  const auto& calib = input.calibration;
+  spdlog::info("{}: {}, {}x{}, baseline {:.3f} m, lines {}, place recognition {}", input.name,
+               ds ? fmt::format("{} frames, {:.1f} fps", ds->size(), ds->fps()) : std::string("live camera"),
+               calib.width, calib.height, calib.baseline, options.extractor.lines ? "on" : "off",
                vocabulary ? fmt::format("on ({} words)", vocabulary->size()) : std::string("off"));
 
-  system::System slam(ds->calibration(), options, vocabulary);
+  system::System slam(calib, options, vocabulary);
   nlohmann::json map_stats = {{"loaded", args.load_map.empty() ? nlohmann::json(nullptr) : nlohmann::json(args.load_map)},
                                {"localization_only", args.localize},
                                {"saved", nullptr}};
@@ -125,15 +179,33 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   std::string fatal;
   const auto start = std::chrono::steady_clock::now();
   auto last_progress = start;
-  report.input_frames = ds->size();
+  report.input_frames = ds ? ds->size() : 0;
   std::size_t reached = 0;  // input frames before the one the run stopped at
-  io::FrameStream stream(*ds);
+  std::size_t done = 0;
+  std::unique_ptr<io::LiveCapture> live;
+  auto process = [&](const io::StereoFrame& frame) {
+    const auto r = slam.process(frame);
+    report.add(r);
+    reached = frame.index + 1;
+    ++done;
+    const auto now = std::chrono::steady_clock::now();
+    if (!args.quiet && (now - last_progress > std::chrono::seconds(1) || (ds && done == ds->size()))) {
+      last_progress = now;
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      spdlog::info("frame {}{}  {:.1f} fps  {}  KF {}  MP {}  ML {}  loops {}{}", done,
+                   ds ? fmt::format("/{}", ds->size()) : std::string(), done / elapsed,
+                   tracking::to_string(r.track.state), slam.map().num_keyframes(), slam.map().num_points(),
+                   slam.map().num_lines(), slam.loop_closer() ? slam.loop_closer()->stats().loops.size() : 0,
+                   live ? fmt::format("  dropped {}", live->dropped()) : std::string());
+    }
+  };
+  std::optional<io::FrameStream> stream;
+  if (ds) stream.emplace(*ds);
   try {
-    std::size_t done = 0;
-    while (!app::stop_requested()) {
-      auto frame = stream.next();
+    while (ds && !app::stop_requested()) {
+      auto frame = stream->next();
       if (!frame) {
-        reached = ds->size();
+        reached = report.input_frames = stream->input_frames();  // fewer when a video ended early
         report.complete = true;
         break;
       }
@@ -142,23 +214,52 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
         const double t_rel = frame->timestamp - ds->timestamps().front();
         std::this_thread::sleep_until(start + std::chrono::duration<double>(t_rel));
       }
-      const auto r = slam.process(*frame);
-      report.add(r);
-      reached = frame->index + 1;
-      ++done;
-      const auto now = std::chrono::steady_clock::now();
-      if (!args.quiet && (now - last_progress > std::chrono::seconds(1) || done == ds->size())) {
-        last_progress = now;
-        const double elapsed = std::chrono::duration<double>(now - start).count();
-        spdlog::info("frame {}/{}  {:.1f} fps  {}  KF {}  MP {}  ML {}  loops {}", done, ds->size(), done / elapsed,
-                     tracking::to_string(r.track.state), slam.map().num_keyframes(), slam.map().num_points(),
-                     slam.map().num_lines(), slam.loop_closer() ? slam.loop_closer()->stats().loops.size() : 0);
+      process(*frame);
+    }
+    if (input.camera) {
+      // Capturing starts now, with everything loaded: the camera's frames go to the newest-frame
+      // slot, and those tracking had no time for are dropped and counted (io/live_capture.h).
+      live = std::make_unique<io::LiveCapture>(std::move(input.camera));
+      bool blank = false;
+      while (!app::stop_requested()) {
+        if (args.dataset.max_frames >= 0 && done >= static_cast<std::size_t>(args.dataset.max_frames)) {
+          report.complete = true;
+          break;
+        }
+        // A short wait, so that a signal is noticed while the camera delivers nothing.
+        auto frame = live->next(std::chrono::milliseconds(100));
+        if (!frame) {
+          report.complete = live->ended();
+          if (report.complete) break;
+          continue;
+        }
+        std::string problem = io::blank_image_problem(frame->left, live->name());
+        if (problem.empty()) problem = io::blank_image_problem(frame->right, live->name());
+        if (!problem.empty()) {
+          if (!blank) spdlog::warn("skipping frame {}: {} (and the blank frames right after it)", frame->index, problem);
+          report.skipped.push_back({frame->index, frame->timestamp, std::move(problem)});
+          blank = true;
+          continue;
+        }
+        blank = false;
+        process(*frame);
       }
     }
   } catch (const InputError& e) {
     fatal = e.what();  // outputs so far are still written below
   }
-  for (auto& s : stream.skipped_frames()) {
+  nlohmann::json live_stats = nullptr;
+  if (live) {
+    live->stop();
+    report.input_frames = live->captured();
+    live_stats = {{"source", live->name()}, {"captured", live->captured()}, {"taken", live->taken()},
+                  {"dropped", live->dropped()}};
+    const auto log = live->dropped() > 0 ? spdlog::level::warn : spdlog::level::info;
+    spdlog::log(log, "{}: {} frames captured, {} taken by tracking, {} dropped (tracking was busy when the next one "
+                     "came)",
+                live->name(), live->captured(), live->taken(), live->dropped());
+  }
+  for (auto& s : stream ? stream->skipped_frames() : std::vector<io::SkippedFrame>{}) {
     // Frames skipped before the stopping point belong to this run; the reader may have run ahead.
     if (s.index < reached) report.skipped.push_back(std::move(s));
   }
@@ -171,11 +272,11 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     // After local mapping and loop closing (and its global BA) finished: the map as it ends.
     const auto t0 = std::chrono::steady_clock::now();
     system::MapFileMeta meta;
-    meta.created_by = fmt::format("plslam {} run {}", kVersion, ds->root().string());
-    meta.config = map_config_text(args, ds->format());
+    meta.created_by = fmt::format("plslam {} run {}", kVersion, input.name);
+    meta.config = map_config_text(args, preset);
     if (gt_anchor) {
       meta.T_gt_map = gt_anchor;  // a loaded map keeps the anchor it came with
-    } else if (const auto* first = slam.map().first_keyframe(); first && !first->is_bad()) {
+    } else if (const auto* first = slam.map().first_keyframe(); ds && first && !first->is_bad()) {
       meta.T_gt_map = system::ground_truth_anchor(*ds, *first);
     }
     const auto contents = slam.capture_map(std::move(meta));
@@ -190,6 +291,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     // none is written; stats.json says what happened.
     stats_out = with_interruption(report.to_json(slam));
     stats_out["map"] = map_stats;
+    stats_out["live"] = live_stats;
     const auto stats_text = stats_out.dump(2);
     io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats_text << "\n"; });
     if (!fatal.empty()) throw InputError("", fatal);
@@ -197,24 +299,28 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     if (!args.load_map.empty()) {
       std::cerr << fmt::format("plslam: error: {}: the camera was never found in the map {} in {} frames; "
                                "no trajectory written\n",
-                               ds->root().string(), args.load_map, report.frames);
+                               input.name, args.load_map, report.frames);
     } else {
       std::cerr << fmt::format(
           "plslam: error: {}: tracking never initialised in {} frames (no frame had {} stereo points); "
           "no trajectory written\n",
-          ds->root().string(), report.frames, options.tracker.init_min_points);
+          input.name, report.frames, options.tracker.init_min_points);
     }
     return kExitNotInitialized;
   }
 
   const auto traj = slam.tracked_trajectory();
   io::write_trajectory(out_dir / "trajectory.tum", traj, io::TrajectoryFormat::kTum);
-  const std::vector<double> reached_times(ds->timestamps().begin(),
-                                          ds->timestamps().begin() + static_cast<std::ptrdiff_t>(reached));
-  const auto aligned = system::align_to_input(slam.tracker().records(), reached_times);
-  report.untracked_lines = aligned.untracked;
-  if (ds->format() == io::DatasetFormat::kKitti) {
-    io::write_trajectory(out_dir / "trajectory.kitti", aligned.poses, io::TrajectoryFormat::kKitti);
+  if (ds) {
+    // One line per input frame needs every input frame's time: a live camera has none for the
+    // frames it dropped, and no format pairing poses by line.
+    const std::vector<double> reached_times(ds->timestamps().begin(),
+                                            ds->timestamps().begin() + static_cast<std::ptrdiff_t>(reached));
+    const auto aligned = system::align_to_input(slam.tracker().records(), reached_times);
+    report.untracked_lines = aligned.untracked;
+    if (ds->format() == io::DatasetFormat::kKitti) {
+      io::write_trajectory(out_dir / "trajectory.kitti", aligned.poses, io::TrajectoryFormat::kKitti);
+    }
   }
   io::write_trajectory(out_dir / "keyframes.tum", slam.keyframe_trajectory(), io::TrajectoryFormat::kTum);
   io::write_file_atomically(out_dir / "frames.csv", [&](std::ostream& o) { report.write_frames_csv(o); });
@@ -227,7 +333,8 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
 
   auto stats = with_interruption(report.to_json(slam));
   stats["map"] = map_stats;
-  if (ds->ground_truth()) {
+  stats["live"] = live_stats;
+  if (ds && ds->ground_truth()) {
     // Tracked poses only: a prediction made while lost is not an estimate to score.
     try {
       const auto accuracy = system::evaluate_against_ground_truth(*ds, traj);
@@ -301,8 +408,23 @@ int run_repeated(const RunArgs& args) {
 
 CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](CLI::App& sub) {
                            auto args = std::make_shared<RunArgs>();
-                           add_dataset_options(sub, args->dataset);
+                           add_dataset_options(sub, args->dataset, "--max-frames", false);
                            sub.add_option("--out", args->out, "Output folder")->required();
+                           sub.add_option("--video", args->video,
+                                          "Side-by-side stereo video (left | right halves, rectified) instead of a "
+                                          "dataset folder; a ground_truth.tum beside it is used");
+                           auto* camera = sub.add_option("--camera", args->camera,
+                                                         "Live V4L2 camera, e.g. /dev/video0: side-by-side frames, "
+                                                         "or the left camera with --camera-right (a video file is "
+                                                         "played at its frame rate, as a camera would deliver it)");
+                           sub.add_option("--camera-right", args->camera_right, "The right camera's device")
+                               ->needs(camera);
+                           sub.add_option("--calib", args->calib,
+                                          "Stereo calibration of the rectified images, for --video and --camera "
+                                          "(YAML: width height fx fy cx cy baseline)");
+                           sub.add_option("--preset", args->preset,
+                                          "Configuration preset (default: kitti for KITTI datasets, else euroc)")
+                               ->check(CLI::IsMember({"euroc", "kitti"}));
                            sub.add_option("--config", args->config,
                                           "YAML configuration (default: the preset for the dataset format)");
                            sub.add_option("--vocabulary", args->vocabulary,
@@ -313,7 +435,8 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                                         "No loop closing (odometry with local mapping only)");
                            sub.add_flag("--no-lines", args->no_lines, "Points only");
                            sub.add_flag("--quiet", args->quiet, "No progress lines");
-                           sub.add_flag("--realtime", args->realtime, "Pace the input at the dataset's frame rate");
+                           sub.add_flag("--realtime", args->realtime, "Pace the input at the dataset's frame rate")
+                               ->excludes(camera);
                            sub.add_flag("--sequential", args->sequential,
                                         "Run local mapping and loop closing in the tracking thread (reproducible runs)");
                            sub.add_option("--save-map", args->save_map,
@@ -325,8 +448,10 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                                ->needs(load);
                            sub.add_option("--repeat", args->repeat,
                                           "Run N times into DIR/run-1..N and report the ATE's median, min and max")
-                               ->check(CLI::Range(1, 1000));
+                               ->check(CLI::Range(1, 1000))
+                               ->excludes(camera);
                            return std::function<int()>([args] {
+                             check_input_args(*args);
                              if (args->repeat > 1) return run_repeated(*args);
                              nlohmann::json stats;
                              return run_slam(*args, args->out, stats);

@@ -150,7 +150,9 @@ plslam::cli::CommandRegistration reg({"synth", "Render a synthetic stereo sequen
                                         sub.add_option("--frames", o->frames, "Number of stereo frames")
                                             ->capture_default_str()
                                             ->check(CLI::Range(2, 1000000));
-                                        sub.add_option("--format", o->format, "euroc|kitti (default: the preset's)");
+                                        sub.add_option("--format", o->format,
+                                                       "euroc|kitti|video (default: the preset's layout; video: a "
+                                                       "side-by-side FFV1 video with its calibration file)");
                                         sub.add_option("--preset", o->preset, "Camera preset: euroc|kitti")
                                             ->capture_default_str();
                                         sub.add_option("--fps", o->fps,

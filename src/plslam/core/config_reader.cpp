@@ -52,6 +52,8 @@ YAML::Node ConfigReader::lookup(const std::string& key) const {
   return child;
 }
 
+bool ConfigReader::has(const std::string& key) const { return node_.IsMap() && node_[key]; }
+
 ConfigReader ConfigReader::section(const std::string& key) const {
   YAML::Node child = lookup(key);
   if (!child || child.IsNull()) return ConfigReader(YAML::Node(YAML::NodeType::Map), state_, full(key));

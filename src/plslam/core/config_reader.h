@@ -22,6 +22,9 @@ class ConfigReader {
   // The sub-section `key` (e.g. "features"); an absent section reads as empty.
   ConfigReader section(const std::string& key) const;
 
+  // Whether `key` is present (without marking it as read): for files where a key is required.
+  bool has(const std::string& key) const;
+
   // Overwrites `value` when `key` is present. A value of the wrong type throws InputError naming
   // the file and the full key, e.g. "features.n_points: expected an integer".
   void get(const std::string& key, bool& value) const;

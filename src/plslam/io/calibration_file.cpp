@@ -1,19 +1,62 @@
 #include "plslam/io/calibration_file.h"
 
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
 #include "plslam/core/config_reader.h"
+#include "plslam/core/error.h"
+#include "plslam/core/input_file.h"
+#include "plslam/io/atomic_file.h"
 
 namespace plslam::io {
+
+namespace {
+
+void require(const ConfigReader& reader, const char* key, const char* meaning) {
+  if (!reader.has(key)) throw InputError(reader.source(), fmt::format("{}: missing ({})", key, meaning));
+}
+
+template <class T>
+T read_positive(const ConfigReader& reader, const char* key, const char* meaning) {
+  require(reader, key, meaning);
+  T value{};
+  reader.get(key, value);  // wrong types and non-finite numbers fail here, naming the key
+  if (!(value > 0)) throw InputError(reader.source(), fmt::format("{}: must be positive, got {}", key, value));
+  return value;
+}
+
+}  // namespace
+
 StereoCalibration read_calibration_file(const std::filesystem::path& path) {
-  const auto config = ConfigReader::from_file(path);
+  std::ifstream in = open_text_file(path, "calibration file not found");
+  std::stringstream text;
+  text << in.rdbuf();
+  const ConfigReader reader = ConfigReader::from_string(text.str(), path.string());
   StereoCalibration c;
-  config.get("width", c.width);
-  config.get("height", c.height);
-  config.get("fx", c.fx);
-  config.get("fy", c.fy);
-  config.get("cx", c.cx);
-  config.get("cy", c.cy);
-  config.get("baseline", c.baseline);
-  config.check_all_used();
+  c.width = read_positive<int>(reader, "width", "image width in pixels of one camera");
+  c.height = read_positive<int>(reader, "height", "image height in pixels");
+  c.fx = read_positive<double>(reader, "fx", "rectified focal length in pixels, P1(0,0)");
+  c.fy = read_positive<double>(reader, "fy", "rectified focal length in pixels, P1(1,1)");
+  c.cx = read_positive<double>(reader, "cx", "rectified principal point in pixels, P1(0,2)");
+  c.cy = read_positive<double>(reader, "cy", "rectified principal point in pixels, P1(1,2)");
+  c.baseline = read_positive<double>(reader, "baseline", "metres, -P2(0,3) / P2(0,0)");
+  reader.check_all_used();
   return c;
 }
+
+void write_calibration_file(const std::filesystem::path& path, const StereoCalibration& c) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << "# plslam stereo calibration of RECTIFIED images (README: Video and camera input).\n"
+        << "# width, height: one camera's image in pixels (a side-by-side frame is 2 * width wide);\n"
+        << "# fx, fy, cx, cy: the rectified pinhole intrinsics in pixels (stereoRectify's P1);\n"
+        << "# baseline: metres between the cameras, -P2(0,3) / P2(0,0).\n"
+        << fmt::format("width: {}\nheight: {}\n", c.width, c.height)
+        << fmt::format("fx: {:.17g}\nfy: {:.17g}\ncx: {:.17g}\ncy: {:.17g}\n", c.fx, c.fy, c.cx, c.cy)
+        << fmt::format("baseline: {:.17g}\n", c.baseline);
+  });
+}
+
 }  // namespace plslam::io

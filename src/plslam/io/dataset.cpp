@@ -16,6 +16,7 @@ const char* to_string(DatasetFormat f) {
     case DatasetFormat::kAuto: return "auto";
     case DatasetFormat::kKitti: return "kitti";
     case DatasetFormat::kEuroc: return "euroc";
+    case DatasetFormat::kVideo: return "video";
   }
   return "?";
 }

@@ -10,14 +10,25 @@
 
 #include <opencv2/core.hpp>
 
+#include "plslam/core/error.h"
 #include "plslam/core/types.h"
 
 namespace plslam::io {
 
-enum class DatasetFormat { kAuto, kKitti, kEuroc };
+// kVideo: a side-by-side stereo video with a calibration file (io/video_dataset.h); never
+// detected, the user names it.
+enum class DatasetFormat { kAuto, kKitti, kEuroc, kVideo };
 
 const char* to_string(DatasetFormat f);
 DatasetFormat parse_dataset_format(const std::string& name);  // auto|kitti|euroc
+
+// Thrown by Dataset::load(i) of an input that is decoded in order (a video) when it ended before
+// frame i although its header counted more frames: there is no frame i or later, and the frame
+// stream ends there instead of trying each of them.
+class InputEnded : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 struct StereoFrame {
   std::size_t index = 0;  // index within the selected range

@@ -7,7 +7,10 @@
 namespace plslam::io {
 
 FrameStream::FrameStream(const Dataset& dataset, std::size_t capacity)
-    : dataset_(dataset), capacity_(capacity == 0 ? 1 : capacity), worker_([this] { run(); }) {}
+    : dataset_(dataset),
+      capacity_(capacity == 0 ? 1 : capacity),
+      input_frames_(dataset.size()),
+      worker_([this] { run(); }) {}
 
 FrameStream::~FrameStream() {
   {
@@ -35,6 +38,12 @@ void FrameStream::run() {
           frame.reset();
           spdlog::warn("skipping frame {}: {}", i, reason);
         }
+      } catch (const InputEnded& e) {
+        // Frames i and later do not exist: the sequence ends here rather than skipping each.
+        spdlog::warn("{}; the sequence ends at frame {} of {}", e.what(), i, dataset_.size());
+        std::lock_guard lock(mutex_);
+        input_frames_ = i;
+        break;
       } catch (const InputError& e) {
         reason = e.what();
         spdlog::warn("skipping frame {}: {}", i, reason);
@@ -67,6 +76,11 @@ std::optional<StereoFrame> FrameStream::next() {
   }
   if (error_) std::rethrow_exception(error_);
   return std::nullopt;
+}
+
+std::size_t FrameStream::input_frames() const {
+  std::lock_guard lock(mutex_);
+  return input_frames_;
 }
 
 std::size_t FrameStream::skipped() const {

@@ -35,6 +35,10 @@ class FrameStream {
   // once (error log naming the file) and skipped; other failures are rethrown here.
   std::optional<StereoFrame> next();
 
+  // The frames the input really holds: the dataset's size, or fewer when it ended early (a video
+  // shorter than its header said; InputEnded). Final once next() has returned nullopt.
+  std::size_t input_frames() const;
+
   std::size_t skipped() const;
   // Every frame skipped so far, in order, with the reason.
   std::vector<SkippedFrame> skipped_frames() const;
@@ -51,6 +55,7 @@ class FrameStream {
   std::condition_variable cv_;
   std::deque<StereoFrame> queue_;
   std::vector<SkippedFrame> skipped_;
+  std::size_t input_frames_;
   bool done_ = false;
   bool stop_ = false;
   std::exception_ptr error_;

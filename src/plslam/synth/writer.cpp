@@ -2,16 +2,21 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <fstream>
 #include <mutex>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+#include <spdlog/spdlog.h>
 
 #include "plslam/core/error.h"
 #include "plslam/core/worker_pool.h"
+#include "plslam/io/calibration_file.h"
 #include "plslam/io/trajectory_io.h"
+#include "plslam/io/video_dataset.h"
 
 namespace plslam::synth {
 
@@ -20,7 +25,8 @@ namespace fs = std::filesystem;
 OutputFormat parse_output_format(const std::string& name) {
   if (name == "euroc") return OutputFormat::kEuroc;
   if (name == "kitti") return OutputFormat::kKitti;
-  throw InputError("", "unknown format '" + name + "' (expected euroc or kitti)");
+  if (name == "video") return OutputFormat::kVideo;
+  throw InputError("", "unknown format '" + name + "' (expected euroc, kitti or video)");
 }
 
 Eigen::Isometry3d euroc_T_BS_cam0() {
@@ -123,42 +129,105 @@ void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const E
   open_out(dir / "synth.json") << j.dump(2) << "\n";
 }
 
-// False when `cancelled` stopped it before every frame was written.
+// False when `cancelled` stopped it before every frame was written. With `in_order` (a video),
+// batches of a few chunks per thread are rendered in parallel, kept, and handed to `sink` in frame
+// order from the calling thread, so memory holds one batch however long the sequence is;
+// otherwise `sink` runs on the rendering threads, in any order.
 bool render_all(const Sequence& seq, const Progress& progress, int threads, const Cancelled& cancelled,
-                const std::function<void(std::size_t, const StereoImages&)>& sink) {
+                const std::function<void(std::size_t, const StereoImages&)>& sink, bool in_order = false) {
   const std::size_t n = seq.size();
   std::size_t done = 0;
   std::mutex mu;
   std::atomic<bool> stopped{false};
   // Chunks of 8 frames, each with its own renderer (it keeps per-thread scratch images).
   constexpr std::size_t kChunk = 8;
-  auto body = [&](int c) {
-    StereoRenderer renderer(seq);
-    const std::size_t begin = static_cast<std::size_t>(c) * kChunk, end = std::min(n, begin + kChunk);
-    for (std::size_t i = begin; i < end; ++i) {
-      if (stopped.load() || (cancelled && cancelled())) {
-        stopped.store(true);
-        return;
+  std::unique_ptr<core::WorkerPool> pool;
+  if (threads != 1) pool = std::make_unique<core::WorkerPool>(threads);
+  const std::size_t per_batch = in_order ? kChunk * 2 * static_cast<std::size_t>(pool ? pool->threads() : 1) : n;
+  std::vector<StereoImages> batch;
+  for (std::size_t first = 0; first < n; first += per_batch) {
+    const std::size_t last = std::min(n, first + per_batch);
+    if (in_order) batch.assign(last - first, {});
+    auto body = [&](int c) {
+      StereoRenderer renderer(seq);
+      const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk, end = std::min(last, begin + kChunk);
+      for (std::size_t i = begin; i < end; ++i) {
+        if (stopped.load() || (cancelled && cancelled())) {
+          stopped.store(true);
+          return;
+        }
+        if (in_order) {
+          batch[i - first] = renderer.render(i);
+        } else {
+          sink(i, renderer.render(i));
+        }
+        std::lock_guard<std::mutex> lock(mu);
+        ++done;
+        if (progress) progress(done, n);
       }
-      sink(i, renderer.render(i));
-      std::lock_guard<std::mutex> lock(mu);
-      ++done;
-      if (progress) progress(done, n);
+    };
+    const int chunks = static_cast<int>((last - first + kChunk - 1) / kChunk);
+    if (pool) {
+      pool->run(chunks, body);
+    } else {
+      for (int c = 0; c < chunks; ++c) body(c);
     }
-  };
-  const int chunks = static_cast<int>((n + kChunk - 1) / kChunk);
-  if (threads == 1) {
-    for (int c = 0; c < chunks; ++c) body(c);
-  } else {
-    core::WorkerPool(threads).run(chunks, body);
+    if (stopped.load()) return false;
+    for (std::size_t k = 0; in_order && k < batch.size(); ++k) sink(first + k, batch[k]);
   }
-  return !stopped.load();
+  return true;
+}
+
+// The video layout (writer.h). FFV1 keeps every grey level exactly, so a run on the video sees
+// the images a run on the image folders sees.
+bool write_video(const Sequence& seq, const fs::path& dir, const Progress& progress, int threads,
+                 const Cancelled& cancelled) {
+  const auto& pr = seq.options().preset;
+  const std::size_t n = seq.size();
+  fs::create_directories(dir);
+  const fs::path video = dir / kVideoFile;
+  io::quiet_ffmpeg_log();
+  cv::VideoWriter writer;
+  if (!writer.open(video.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc('F', 'F', 'V', '1'), pr.fps,
+                   cv::Size(2 * pr.width, pr.height), false)) {
+    throw InputError(video.string(), "cannot write an FFV1 video (OpenCV's FFmpeg backend refused it)");
+  }
+  cv::Mat side_by_side;
+  const bool complete = render_all(
+      seq, progress, threads, cancelled,
+      [&](std::size_t, const StereoImages& im) {
+        cv::hconcat(im.left, im.right, side_by_side);
+        writer.write(side_by_side);
+      },
+      true);
+  writer.release();
+  if (!complete) return false;
+  // VideoWriter reports no write errors (a full disk): read the header back. The rate is stored as
+  // a fraction, so the ground truth takes the rate a reader gets, and its times match the frames'.
+  cv::VideoCapture check(video.string(), cv::CAP_FFMPEG);
+  const double frames = check.get(cv::CAP_PROP_FRAME_COUNT), fps = check.get(cv::CAP_PROP_FPS);
+  if (!check.isOpened() || frames != static_cast<double>(n) || !(fps > 0)) {
+    throw InputError(video.string(), fmt::format("the written video reads back as {} frames at {} Hz, not {} at {}",
+                                                 frames, fps, n, pr.fps));
+  }
+  if (std::abs(fps - pr.fps) > 1e-9 * pr.fps) spdlog::info("synth: {} stores the rate as {:.9g} Hz", video.string(), fps);
+  io::write_calibration_file(dir / kVideoCalibrationFile, seq.calibration());
+  std::vector<double> times;
+  Trajectory left;
+  for (std::size_t i = 0; i < n; ++i) {
+    times.push_back(static_cast<double>(i) / fps);
+    left.push_back({times.back(), seq.left_pose(i)});
+  }
+  io::write_trajectory(io::video_ground_truth_path(video), left, io::TrajectoryFormat::kTum);
+  write_ground_truth_extras(seq, dir / "synth", Eigen::Isometry3d::Identity(), times, "scene world");
+  return true;
 }
 
 }  // namespace
 
 bool write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat format, const Progress& progress,
                     int threads, const Cancelled& cancelled) {
+  if (format == OutputFormat::kVideo) return write_video(seq, dir, progress, threads, cancelled);
   const std::size_t n = seq.size();
   if (format == OutputFormat::kEuroc) {
     const fs::path mav = dir / "mav0";

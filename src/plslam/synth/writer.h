@@ -9,6 +9,11 @@
 //     DIR/sequences/00/{image_0,image_1}/NNNNNN.png, calib.txt, times.txt
 //     DIR/poses/00.txt                                        (left camera, first pose identity)
 //     DIR/sequences/00/synth/                                 (extra ground truth, below)
+//   Side-by-side video (--format video), as `plslam run --video` reads it:
+//     DIR/stereo.mkv          left | right in each frame, FFV1 (lossless) grey, at the preset's rate
+//     DIR/calibration.yaml    the rectified calibration (io/calibration_file.h)
+//     DIR/ground_truth.tum    left camera in the scene's world, seconds from the first frame
+//     DIR/synth/                                              (extra ground truth, below)
 //
 //   synth/segments_3d.txt   "x1 y1 z1 x2 y2 z2" per line: every straight scene edge
 //   synth/points_3d.txt     "x y z" per line: surface sample points
@@ -16,7 +21,7 @@
 //   synth/synth.json        the options (scene, preset, seed, loop, ...) and the frame used;
 //                           written last, so its presence marks a complete sequence
 // All synth/ coordinates are in the frame of that layout's ground truth: the EuRoC world
-// (z up) or, for KITTI, the first left camera.
+// (z up), for KITTI the first left camera, for the video the scene's world.
 #include <filesystem>
 #include <functional>
 
@@ -26,8 +31,12 @@
 
 namespace plslam::synth {
 
-enum class OutputFormat { kEuroc, kKitti };
-OutputFormat parse_output_format(const std::string& name);  // euroc|kitti; InputError otherwise
+enum class OutputFormat { kEuroc, kKitti, kVideo };
+OutputFormat parse_output_format(const std::string& name);  // euroc|kitti|video; InputError otherwise
+
+// File names of the video layout inside DIR.
+inline constexpr const char* kVideoFile = "stereo.mkv";
+inline constexpr const char* kVideoCalibrationFile = "calibration.yaml";
 
 // Sensor-to-body transform of cam0 used in the EuRoC layout (p_body = T_BS * p_cam0).
 Eigen::Isometry3d euroc_T_BS_cam0();
