@@ -397,7 +397,7 @@ void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf) {
     if (!n->is_bad()) local.push_back(n);
   }
   MapBaProblem window(options_.line_information, options_.far_stereo_baselines, options_.lines);
-  for (auto* k : local) window.add_keyframe(k, k->id() == 0);
+  for (auto* k : local) window.add_keyframe(k, k->is_origin());
   window.add_landmarks_of(local);
   const auto& problem = window.problem;
   if (problem.point_observations.empty()) return;
@@ -455,7 +455,7 @@ void LocalMapper::cull_keyframes(map::KeyFrame* kf) {
   // scale, by at least three other keyframes (ORB-SLAM2's KeyFrameCulling).
   int culled = 0;
   for (map::KeyFrame* k : kf->covisibles()) {
-    if (k->id() == 0 || k->is_bad() || !k->loop_edges().empty()) continue;
+    if (k->is_origin() || k->is_bad() || !k->loop_edges().empty()) continue;
     const auto& d = k->data();
     const double th_depth = 40.0 * d.calib.baseline;
     const auto pts = k->map_points();
