@@ -73,8 +73,8 @@ SystemOptions apply_config(const ConfigReader& config, SystemOptions o) {
 
   const auto mapping = config.section("mapping");
   mapping.get("local_ba", o.mapper.local_ba);
-  mapping.get("ba_iterations", o.mapper.ba_iterations);
-  mapping.get("culling_redundancy", o.mapper.culling_redundancy);
+  mapping.get("ba_iterations", o.mapper.ba.iterations);
+  mapping.get("culling_redundancy", o.mapper.keyframe_culling.redundancy);
 
   const auto place = config.section("place");
   place.get("enabled", o.place_recognition);
