@@ -92,6 +92,25 @@ TEST(Map, FirstKeyframeIsNeverCulled) {
   EXPECT_FALSE(f.k[0]->is_bad());
 }
 
+TEST(Map, TheOriginIsTheFirstKeyframeWhateverItsId) {
+  Fixture f;
+  EXPECT_TRUE(f.k[0]->is_origin());
+  EXPECT_FALSE(f.k[1]->is_origin());
+  // A loaded map whose lowest id is not 0 (its keyframe 0 was culled before it was saved): the
+  // first restored keyframe holds the gauge and is never culled; keyframes made later do not.
+  Map loaded;
+  KeyFrame* a = loaded.restore_keyframe(4, make_data(4, 10), geometry::SE3());
+  KeyFrame* b = loaded.restore_keyframe(9, make_data(9, 10), geometry::SE3());
+  EXPECT_EQ(loaded.first_keyframe(), a);
+  EXPECT_TRUE(a->is_origin());
+  EXPECT_FALSE(b->is_origin());
+  a->set_bad();
+  EXPECT_FALSE(a->is_bad());
+  KeyFrame* c = loaded.create_keyframe(make_data(10, 10), geometry::SE3());
+  EXPECT_EQ(c->id(), 10);
+  EXPECT_FALSE(c->is_origin());
+}
+
 TEST(Map, ReplacingAPointMovesItsObservations) {
   Map map;
   KeyFrame* a = map.create_keyframe(make_data(0, 10), geometry::SE3());

@@ -1,5 +1,6 @@
 #include "plslam/loop/global_ba.h"
 
+#include <algorithm>
 #include <deque>
 #include <stdexcept>
 
@@ -20,7 +21,11 @@ GlobalBaSnapshot snapshot_for_global_ba(const map::Map& map, const GlobalBaOptio
   const auto keyframes = split_unmapped(map.keyframes()).connected;
   if (keyframes.empty()) return s;
   s.camera = geometry::StereoCamera(keyframes.front()->data().calib);
-  for (map::KeyFrame* kf : keyframes) s.problem->add_keyframe(kf, kf == keyframes.front());
+  // The origin holds the gauge; without it among the connected keyframes, the oldest one does.
+  const bool has_origin = std::any_of(keyframes.begin(), keyframes.end(), [](auto* kf) { return kf->is_origin(); });
+  for (map::KeyFrame* kf : keyframes) {
+    s.problem->add_keyframe(kf, has_origin ? kf->is_origin() : kf == keyframes.front());
+  }
   s.problem->add_landmarks_of(keyframes);
   return s;
 }

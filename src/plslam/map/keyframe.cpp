@@ -7,8 +7,8 @@
 
 namespace plslam::map {
 
-KeyFrame::KeyFrame(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw)
-    : id_(id), data_(std::move(data)), T_cw_(T_cw), T_wc_(T_cw.inverse()),
+KeyFrame::KeyFrame(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw, bool origin)
+    : id_(id), origin_(origin), data_(std::move(data)), T_cw_(T_cw), T_wc_(T_cw.inverse()),
       points_(data_->keypoints.size(), nullptr), lines_(data_->lines.size(), nullptr) {}
 
 geometry::SE3 KeyFrame::pose() const {
@@ -245,7 +245,7 @@ IdSet<KeyFrame> KeyFrame::loop_edges() const {
 }
 
 void KeyFrame::set_bad() {
-  if (id_ == 0) return;
+  if (origin_) return;
   for (auto* kf : covisibles()) kf->erase_connection(this);
   for (std::size_t i = 0; i < points_.size(); ++i) {
     if (auto* p = map_point(static_cast<int>(i))) p->erase_observation(this);

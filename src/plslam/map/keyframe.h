@@ -21,9 +21,13 @@ class MapLine;
 
 class KeyFrame {
  public:
-  KeyFrame(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw);
+  // `origin`: the map's first keyframe (Map::first_keyframe()), whatever its id.
+  KeyFrame(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw, bool origin = false);
 
   long id() const { return id_; }
+  // The keyframe that holds the map's gauge: never culled, fixed in local and global BA. It is the
+  // map's first keyframe, which need not have id 0 (a loaded map's first one is its lowest id).
+  bool is_origin() const { return origin_; }
   const FrameData& data() const { return *data_; }
   const std::shared_ptr<const FrameData>& shared_data() const { return data_; }
   long frame_id() const { return data_->frame_id; }
@@ -79,7 +83,7 @@ class KeyFrame {
   // re-attaches it to the tree.
   void restore_graph(KeyFrame* parent, const IdMap<KeyFrame, int>& weights, const IdSet<KeyFrame>& loop_edges);
 
-  // Never removes the first keyframe. Otherwise: detaches from points, lines and the graph,
+  // Never removes the origin. Otherwise: detaches from points, lines and the graph,
   // re-parents its children to their best covisible candidate, and remembers its pose relative
   // to its parent so that frames that referenced it keep a valid pose.
   void set_bad();
@@ -89,6 +93,7 @@ class KeyFrame {
 
  private:
   const long id_;
+  const bool origin_;
   const std::shared_ptr<const FrameData> data_;
 
   mutable std::mutex pose_mutex_;

@@ -9,7 +9,8 @@ namespace plslam::map {
 KeyFrame* Map::create_keyframe(std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw) {
   std::lock_guard lock(mutex_);
   ++changes_;
-  all_keyframes_.push_back(std::make_unique<KeyFrame>(next_keyframe_id_++, std::move(data), T_cw));
+  const bool origin = all_keyframes_.empty();
+  all_keyframes_.push_back(std::make_unique<KeyFrame>(next_keyframe_id_++, std::move(data), T_cw, origin));
   keyframes_.insert(all_keyframes_.back().get());
   return all_keyframes_.back().get();
 }
@@ -35,7 +36,9 @@ KeyFrame* Map::restore_keyframe(long id, std::shared_ptr<const FrameData> data, 
   std::lock_guard lock(mutex_);
   ++changes_;
   if (id < 0) throw std::invalid_argument("negative keyframe id");
-  all_keyframes_.push_back(std::make_unique<KeyFrame>(id, std::move(data), T_cw));
+  // Map files list keyframes by increasing id: the first restored is the saved map's origin.
+  const bool origin = all_keyframes_.empty();
+  all_keyframes_.push_back(std::make_unique<KeyFrame>(id, std::move(data), T_cw, origin));
   if (!keyframes_.insert(all_keyframes_.back().get()).second) {
     all_keyframes_.pop_back();
     throw std::invalid_argument("duplicate keyframe id " + std::to_string(id));

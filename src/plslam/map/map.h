@@ -49,6 +49,7 @@ class Map {
   std::size_t num_keyframes() const;
   std::size_t num_points() const;
   std::size_t num_lines() const;
+  // The first keyframe created or restored: the origin (KeyFrame::is_origin()), whatever its id.
   KeyFrame* first_keyframe() const;
 
   // Held by whoever changes poses or structure wholesale (local BA write-back) and by tracking

@@ -1,19 +1,24 @@
 #pragma once
 // The local mapping thread (ORB-SLAM2's LocalMapping, with lines): takes new keyframes from
-// tracking, adds their observations and covisibility edges, culls recent map points and lines
-// that tracking fails to find, triangulates new points with neighbouring keyframes, fuses
-// duplicates, runs local BA over points and lines, and culls redundant keyframes.
+// tracking, adds their observations and covisibility edges, then runs the stages, each in a unit
+// of its own: culling of recent landmarks (landmark_culling), triangulation of new points and lines
+// with neighbouring keyframes (landmark_triangulation), fusion of duplicates (landmark_fusion),
+// local BA (local_ba_window) and culling of redundant keyframes (keyframe_culling). This class
+// owns the thread, the queue, pause/resume and the statistics.
 #include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <functional>
-#include <list>
 #include <mutex>
 #include <thread>
 #include <vector>
 
 #include "plslam/map/map.h"
-#include "plslam/optim/bundle_adjustment.h"
+#include "plslam/mapping/keyframe_culling.h"
+#include "plslam/mapping/landmark_culling.h"
+#include "plslam/mapping/landmark_fusion.h"
+#include "plslam/mapping/landmark_triangulation.h"
+#include "plslam/mapping/local_ba_window.h"
 
 namespace plslam::place {
 class KeyframeDatabase;
@@ -23,12 +28,15 @@ namespace plslam::mapping {
 
 struct LocalMapperOptions {
   bool local_ba = true;
-  int ba_iterations = 5;         // first pass (ORB-SLAM2: 5 + 10 without outliers)
-  int ba_second_iterations = 10;
+  LocalBaOptions ba;
+  TriangulationOptions triangulation;
+  FusionOptions fusion;
+  RecentLandmarkOptions recent;
+  KeyframeCullingOptions keyframe_culling;
+  // Shared with tracking and loop closing (the system sets them from TrackerOptions and
+  // --no-lines); they reach the units' options from here, overriding the units' own copies.
   double line_information = 0.5;
-  double far_stereo_baselines = 0;  // as TrackerOptions (set by the system from it)
-  double culling_redundancy = 0.9;  // a keyframe is redundant when this share of its points is seen by 3 others
-  int triangulation_neighbors = 10;
+  double far_stereo_baselines = 0;  // as TrackerOptions
   bool lines = true;
 };
 
@@ -79,8 +87,9 @@ class LocalMapper {
   // Pops the front keyframe (lock held), processes it with the lock released, marks idle again.
   void process_front(std::unique_lock<std::mutex>& lock);
   void process(map::KeyFrame* kf, bool more_waiting);
+  // Adds the keyframe's observations of the landmarks tracking associated, and its covisibility
+  // edges; the landmarks it made itself go on probation.
   void process_new_keyframe(map::KeyFrame* kf);
-  void cull_recent(map::KeyFrame* kf);
   void triangulate(map::KeyFrame* kf);
   void fuse(map::KeyFrame* kf);
   void local_bundle_adjustment(map::KeyFrame* kf);
@@ -100,8 +109,7 @@ class LocalMapper {
   std::thread thread_;
 
   // Touched only by the mapping thread (or the caller of process_pending()).
-  std::list<std::pair<map::MapPoint*, long>> recent_points_;  // point, keyframe id that made it
-  std::list<std::pair<map::MapLine*, long>> recent_lines_;
+  RecentLandmarks recent_;
 
   mutable std::mutex stats_mutex_;
   LocalMapperStats stats_;

@@ -1,22 +1,14 @@
 #pragma once
 // The YAML configuration of `plslam run`: one section per module, defaults in code (the preset
-// for the dataset), unknown keys rejected with their name.
-//
-//   features: {n_points, levels, scale_factor, fast_threshold, distribution: ssc|quadtree}
-//   lines:    {enabled, max_lines}
-//   tracking: {init_min_points, close_depth_baselines, motion_radius, local_map_radius,
-//              line_radius, min_local_inliers}
-//   keyframe: {ratio, max_frames, pid, pid_kp, pid_ki, pid_kd, pid_output_limit, kalman, max_speed,
-//              velocity_min_frames}
-//   optim:    {line_information}
-//   mapping:  {local_ba, ba_iterations, culling_redundancy}
-//   place:    {enabled, vocabulary (relative to the config file)}
-//   relocalization: {enabled, max_candidates, min_bow_matches, min_inliers, search_radius,
-//              new_segment_after_s}
-//   system:   {seed}
+// for the dataset), unknown keys rejected with their name. The keys, their types, defaults and
+// meaning come from one table (config_table.h): list them with config_keys() or
+// `plslam config keys [--json]`.
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "plslam/core/config_reader.h"
 #include "plslam/place/vocabulary.h"
@@ -26,6 +18,21 @@ namespace plslam::system {
 
 // Applies `config` on top of `preset`, validates, and fails on unknown keys.
 SystemOptions apply_config(const ConfigReader& config, SystemOptions preset);
+
+struct ConfigKeyInfo {
+  std::string key;          // "section.name"
+  std::string type;         // bool, int, double or string
+  std::string euroc;        // the default of each preset, as YAML text
+  std::string kitti;
+  // What it accepts, e.g. ">= 0", "in [0, 1]"; empty: any value of its type, or a condition on
+  // several keys of its section (keyframe, loop and ORB options are checked as a whole).
+  std::string valid;
+  std::string description;
+};
+// Every key apply_config() reads, in its order.
+std::vector<ConfigKeyInfo> config_keys();
+// Each key's value in `options`, as YAML text, in config_keys() order: (key, value).
+std::vector<std::pair<std::string, std::string>> config_values(const SystemOptions& options);
 
 // The vocabulary plslam ships (data/vocabulary/, see README: place recognition).
 std::filesystem::path default_vocabulary_path();

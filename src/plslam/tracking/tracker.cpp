@@ -324,7 +324,7 @@ std::optional<geometry::SE3> Tracker::pnp_from_matches(const Frame& f) const {
     const auto& pt = f.data->keypoints[i].pt;
     pixels.emplace_back(pt.x, pt.y);
   }
-  if (world.size() < 15) return std::nullopt;
+  if (world.size() < static_cast<std::size_t>(options_.min_pnp_matches)) return std::nullopt;
   const auto r = geometry::solve_pnp_ransac(geometry::StereoCamera(f.data->calib), world, pixels);
   if (!r.success) return std::nullopt;
   return r.T_cw;
@@ -334,8 +334,8 @@ bool Tracker::track_reference_keyframe(Frame& f, TrackStageTimes& t) {
   const auto t0 = Clock::now();
   bool ok = false;
   if (reference_) {
-    const int n = match_to_keyframe(f, *reference_, 0.75, options_.search);
-    if (n >= 15) {
+    const int n = match_to_keyframe(f, *reference_, options_.reference_match_ratio, options_.search);
+    if (n >= options_.min_reference_matches) {
       // Without a velocity (the first frame of a map, or after the motion model failed) the
       // optimisation starts from the last pose. A car moves 1-3 m per frame: far enough for it to
       // settle on a wrong pose that still keeps many matches (KITTI 01 started one frame later
@@ -396,7 +396,7 @@ void Tracker::update_local_map(Frame& f) {
   const std::size_t direct = local_keyframes_.size();
   for (std::size_t k = 0; k < direct && local_keyframes_.size() < static_cast<std::size_t>(options_.local_keyframes_max); ++k) {
     map::KeyFrame* kf = local_keyframes_[k];
-    for (auto* n : kf->best_covisibles(10)) {
+    for (auto* n : kf->best_covisibles(static_cast<std::size_t>(options_.local_map_covisibles))) {
       if (!n->is_bad() && in_set.insert(n).second) local_keyframes_.push_back(n);
     }
     for (auto* c : kf->children()) {

@@ -31,6 +31,7 @@ struct RelocalizationOptions {
   int min_bow_matches = 15;        // BoW matches a candidate needs before PnP
   int min_pnp_inliers = 10;
   double search_radius = 3.0;      // factor of the local-map search window, around the PnP pose
+  int search_covisibles = 10;      // the candidate's best covisibles whose landmarks are searched too
   int min_inliers = 50;            // point + line inliers to accept (ORB-SLAM2: 50 points)
   // A camera that stays lost this long on frames that could start a map (seconds of textured
   // frames, so a black-out does not count) starts a new map segment instead.
@@ -60,6 +61,13 @@ struct TrackerOptions {
   int min_motion_matches = 20;
   int min_pose_inliers = 10;
   int min_local_inliers = 30;
+  // Tracking against the reference keyframe (no motion model): descriptor matches to its map
+  // points that pass this ratio test, at least `min_reference_matches` of them, and PnP RANSAC
+  // from them as a second start when there are at least `min_pnp_matches`.
+  double reference_match_ratio = 0.75;
+  int min_reference_matches = 15;
+  int min_pnp_matches = 15;
+  int local_map_covisibles = 10;  // best covisibles of each keyframe that sees a match join the local map
   bool lines = true;
   double line_information = 0.5;      // the paper's line information
   SearchOptions search;

@@ -74,7 +74,7 @@ bool Tracker::relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id) {
     std::vector<map::MapPoint*> points;
     std::vector<map::MapLine*> lines;
     std::unordered_set<const void*> seen;
-    auto neighbourhood = kf->best_covisibles(10);
+    auto neighbourhood = kf->best_covisibles(static_cast<std::size_t>(o.search_covisibles));
     neighbourhood.insert(neighbourhood.begin(), kf);
     for (map::KeyFrame* k : neighbourhood) {
       if (k->is_bad()) continue;

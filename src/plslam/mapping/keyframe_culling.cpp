@@ -1,0 +1,42 @@
+#include "plslam/mapping/keyframe_culling.h"
+
+namespace plslam::mapping {
+
+bool is_redundant(const map::KeyFrame& k, const KeyframeCullingOptions& o) {
+  const auto& d = k.data();
+  const double th_depth = o.close_depth_baselines * d.calib.baseline;
+  const auto pts = k.map_points();
+  int total = 0, redundant = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    map::MapPoint* mp = pts[i];
+    if (!mp || mp->is_bad()) continue;
+    if (d.depth[i] > th_depth || d.depth[i] < 0) continue;
+    ++total;
+    if (mp->observation_weight() <= o.observers) continue;
+    const int level = d.keypoints[i].octave;
+    int seen = 0;
+    for (const auto& [other, idx] : mp->observations()) {
+      if (other == &k || other->is_bad()) continue;
+      if (other->data().keypoints[static_cast<std::size_t>(idx)].octave <= level + 1 && ++seen >= o.observers) break;
+    }
+    if (seen >= o.observers) ++redundant;
+  }
+  return total > 0 && redundant > o.redundancy * total;
+}
+
+std::vector<map::KeyFrame*> cull_redundant_keyframes(map::Map& map, const map::KeyFrame& kf,
+                                                     const KeyframeCullingOptions& o,
+                                                     const std::function<void(map::KeyFrame*)>& on_culled) {
+  std::vector<map::KeyFrame*> culled;
+  for (map::KeyFrame* k : kf.covisibles()) {
+    if (k->is_origin() || k->is_bad() || !k->loop_edges().empty()) continue;
+    if (!is_redundant(*k, o)) continue;
+    k->set_bad();
+    map.erase_keyframe(k);
+    if (on_culled) on_culled(k);
+    culled.push_back(k);
+  }
+  return culled;
+}
+
+}  // namespace plslam::mapping

@@ -1,0 +1,78 @@
+#include "plslam/mapping/local_ba_window.h"
+
+#include <mutex>
+
+#include <spdlog/spdlog.h>
+
+#include "plslam/geometry/stereo_camera.h"
+
+namespace plslam::mapping {
+
+MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o) {
+  std::vector<map::KeyFrame*> local{&kf};
+  for (auto* n : kf.covisibles()) {
+    if (!n->is_bad()) local.push_back(n);
+  }
+  MapBaProblem window(o.line_information, o.far_stereo_baselines, o.lines);
+  for (auto* k : local) window.add_keyframe(k, k->is_origin());
+  window.add_landmarks_of(local);
+  return window;
+}
+
+void write_back_local_ba(const MapBaProblem& window, const optim::BaResult& result) {
+  const auto& problem = window.problem;
+  const auto& points = window.points;
+  const auto& lines = window.lines;
+  for (std::size_t i = 0; i < window.point_observers.size(); ++i) {
+    if (!result.point_observation_outlier[i]) continue;
+    map::MapPoint* mp = points[static_cast<std::size_t>(problem.point_observations[i].point)];
+    map::KeyFrame* k = window.point_observers[i];
+    const int idx = mp->index_in(k);
+    if (idx >= 0) k->erase_map_point(idx);
+    mp->erase_observation(k);
+  }
+  for (std::size_t i = 0; i < window.line_observers.size(); ++i) {
+    if (!result.line_observation_outlier[i]) continue;
+    map::MapLine* ml = lines[static_cast<std::size_t>(problem.line_observations[i].line)];
+    map::KeyFrame* k = window.line_observers[i];
+    const int idx = ml->index_in(k);
+    if (idx >= 0) k->erase_map_line(idx);
+    ml->erase_observation(k);
+  }
+  for (std::size_t i = 0; i < window.keyframes.size(); ++i) {
+    if (!problem.keyframes[i].fixed) window.keyframes[i]->set_pose(result.poses[i]);
+  }
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    if (points[p]->is_bad()) continue;
+    points[p]->set_position(result.points[p]);
+    points[p]->update_normal_and_depth();
+  }
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    if (lines[l]->is_bad()) continue;
+    lines[l]->set_endpoints(result.lines[l].start, result.lines[l].end);
+    lines[l]->refit_to_observations();
+    lines[l]->update_normal_and_depth();
+  }
+}
+
+bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o) {
+  const MapBaProblem window = local_ba_window(kf, o);
+  if (window.problem.point_observations.empty()) return false;
+  optim::BaOptions ba;
+  ba.iterations = o.iterations;
+  ba.second_pass_iterations = o.second_iterations;
+  ba.scale_factor = kf.data().scale_factor;
+  ba.linear_solver = optim::BaLinearSolver::kSparseSchur;
+  const geometry::StereoCamera cam(kf.data().calib);
+  const auto result = optim::local_bundle_adjustment(cam, window.problem, ba);
+  if (!result.usable) {
+    spdlog::debug("local BA unusable: {}", result.message);
+    return false;
+  }
+  std::lock_guard lock(map.update_mutex());
+  write_back_local_ba(window, result);
+  map.note_change();  // poses and positions moved: readers of snapshots redraw
+  return true;
+}
+
+}  // namespace plslam::mapping

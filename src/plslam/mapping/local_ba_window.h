@@ -1,0 +1,35 @@
+#pragma once
+// Local bundle adjustment around a new keyframe (ORB-SLAM2's LocalBundleAdjustment, with lines):
+// which keyframes and landmarks it optimises, which keyframes stay fixed, and how the result goes
+// back into the map.
+#include "plslam/map/map.h"
+#include "plslam/mapping/map_ba_problem.h"
+#include "plslam/optim/bundle_adjustment.h"
+
+namespace plslam::mapping {
+
+struct LocalBaOptions {
+  int iterations = 5;          // first pass (ORB-SLAM2: 5 + 10 without outliers)
+  int second_iterations = 10;
+  // Shared with tracking and loop closing: LocalMapper sets them from LocalMapperOptions.
+  double line_information = 0.5;
+  double far_stereo_baselines = 0;
+  bool lines = true;
+};
+
+// The window of `kf`: it and its good covisibles are optimised, except the map's origin, which
+// stays fixed; so are the points (and lines) they see; every other good keyframe that sees those
+// landmarks joins fixed.
+MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o);
+
+// Writes a BA result of `window` back into the map: removes the outlier observations, sets the
+// poses of the free keyframes, the positions of good points and the endpoints of good lines (each
+// line refitted to its observations), with their normals and ranges. The caller holds the map's
+// update mutex.
+void write_back_local_ba(const MapBaProblem& window, const optim::BaResult& result);
+
+// Builds the window of `kf`, optimises it and writes the result back under the map's update
+// mutex. False when there was nothing to optimise or the solver's result was unusable.
+bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o);
+
+}  // namespace plslam::mapping

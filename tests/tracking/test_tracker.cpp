@@ -1,0 +1,170 @@
+// The Tracker on frames with exact ground truth (support/synthetic_views.h): it starts a map from
+// a stereo frame, follows known small motions to within 1e-5, says LOST when the image content
+// disappears, and without place recognition starts a new map segment when it comes back.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "plslam/tracking/tracker.h"
+#include "support/synthetic_views.h"
+
+namespace plslam::tracking {
+namespace tracker_test {
+
+// 1200 points spread over the first camera's image, 2 to 15 m deep (uniform in inverse depth).
+test::SyntheticWorld scene(int points = 1200) {
+  test::SyntheticWorld w;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(10, 630), v(10, 470), inv_z(1 / 15.0, 1 / 2.0);
+  for (int i = 0; i < points; ++i) w.add_point_seen_at(geometry::SE3(), {u(rng), v(rng)}, 1 / inv_z(rng));
+  return w;
+}
+
+// T_cw of frame k of a camera moving 2 cm forward, 1 cm right and turning 0.3 degrees left per
+// frame (20 Hz): a walking pace.
+geometry::SE3 walk(int k) {
+  const geometry::SE3 step(Eigen::AngleAxisd(-0.3 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                           Eigen::Vector3d(-0.01, 0, -0.02));
+  geometry::SE3 T;
+  for (int i = 0; i < k; ++i) T = step * T;
+  return T;
+}
+
+double translation_error(const geometry::SE3& a, const geometry::SE3& b) {
+  return (a.inverse().translation() - b.inverse().translation()).norm();
+}
+double rotation_error(const geometry::SE3& a, const geometry::SE3& b) {
+  return Eigen::AngleAxisd(a.rotation() * b.rotation().transpose()).angle();
+}
+
+struct Rig {
+  map::Map map;
+  std::vector<map::KeyFrame*> inserted;
+  Tracker tracker;
+  explicit Rig(TrackerOptions o = {})
+      : tracker(map, o, [this](map::KeyFrame* kf) { inserted.push_back(kf); }, [] { return true; }) {}
+  geometry::SE3 last_pose() const { return Tracker::pose_of(tracker.records().back()); }
+};
+
+// A frame with nothing in it: a lens cap, a black-out.
+std::shared_ptr<map::FrameData> blank_frame(long id) {
+  auto d = std::make_shared<map::FrameData>();
+  d->frame_id = id;
+  d->timestamp = 0.05 * static_cast<double>(id);
+  d->calib = test::small_calibration();
+  d->descriptors = cv::Mat(0, 32, CV_8U);
+  d->line_descriptors = cv::Mat(0, 32, CV_8U);
+  d->build_grid();
+  return d;
+}
+
+TEST(Tracker, StartsAMapFromTheFirstStereoFrame) {
+  const auto world = scene();
+  Rig rig;
+  const auto view = world.observe(walk(0), 0);
+  int stereo = 0;
+  for (float z : view.data->depth) stereo += z > 0;
+  ASSERT_GE(stereo, 500);
+
+  const TrackResult r = rig.tracker.track(view.data);
+  EXPECT_EQ(r.state, TrackingState::kOk);
+  EXPECT_TRUE(r.tracked);
+  EXPECT_TRUE(r.keyframe);
+  ASSERT_EQ(rig.map.num_keyframes(), 1u);
+  ASSERT_EQ(rig.inserted.size(), 1u);
+  map::KeyFrame* kf = rig.inserted.front();
+  EXPECT_TRUE(kf->is_origin());
+  // One map point per stereo keypoint, where the world point is (float keypoints and depths).
+  EXPECT_EQ(static_cast<int>(rig.map.num_points()), stereo);
+  for (std::size_t i = 0; i < view.point_of.size(); ++i) {
+    map::MapPoint* mp = kf->map_point(static_cast<int>(i));
+    if (view.data->depth[i] <= 0) {
+      EXPECT_EQ(mp, nullptr);
+      continue;
+    }
+    ASSERT_NE(mp, nullptr);
+    EXPECT_LT((mp->position() - world.points[static_cast<std::size_t>(view.point_of[i])]).norm(), 1e-5);
+  }
+  EXPECT_LT(translation_error(rig.last_pose(), walk(0)), 1e-12);
+}
+
+TEST(Tracker, NeedsEnoughStereoPointsToStart) {
+  const auto world = scene(400);  // under init_min_points (500)
+  Rig rig;
+  const TrackResult r = rig.tracker.track(world.observe(walk(0), 0).data);
+  EXPECT_EQ(r.state, TrackingState::kNotInitialized);
+  EXPECT_FALSE(r.tracked);
+  EXPECT_EQ(rig.map.num_keyframes(), 0u);
+  EXPECT_TRUE(rig.inserted.empty());
+}
+
+TEST(Tracker, FollowsAKnownSmallMotion) {
+  const auto world = scene();
+  Rig rig;
+  rig.tracker.track(world.observe(walk(0), 0).data);
+  // Frame 1: no velocity yet, tracked against the reference keyframe. Frames 2-5: the motion model.
+  for (int k = 1; k <= 5; ++k) {
+    const TrackResult r = rig.tracker.track(world.observe(walk(k), k).data);
+    ASSERT_TRUE(r.tracked) << "frame " << k;
+    EXPECT_EQ(r.state, TrackingState::kOk);
+    EXPECT_GT(r.point_inliers, 500) << "frame " << k;
+    EXPECT_LT(translation_error(rig.last_pose(), walk(k)), 1e-5) << "frame " << k;
+    EXPECT_LT(rotation_error(rig.last_pose(), walk(k)), 1e-5) << "frame " << k;
+  }
+  EXPECT_EQ(rig.tracker.lost_events(), 0);
+}
+
+TEST(Tracker, FollowsAKnownSmallMotionWithLinesToo) {
+  auto world = scene();
+  // 40 slanted segments, 3 to 8 m deep, spread over the first camera's image.
+  const auto cam = world.camera();
+  for (int i = 0; i < 40; ++i) {
+    const double u = 60 + 13 * i, z = 3 + 0.125 * i;
+    world.add_segment(cam.unproject({u, 80.0 + 3 * (i % 5)}, z), cam.unproject({u + 25, 400.0 - 4 * (i % 7)}, z + 0.3));
+  }
+  Rig rig;
+  ASSERT_TRUE(rig.tracker.track(world.observe(walk(0), 0).data).tracked);
+  EXPECT_EQ(rig.map.num_lines(), 40u);
+  for (int k = 1; k <= 5; ++k) {
+    const TrackResult r = rig.tracker.track(world.observe(walk(k), k).data);
+    ASSERT_TRUE(r.tracked) << "frame " << k;
+    EXPECT_GT(r.line_inliers, 30) << "frame " << k;
+    EXPECT_LT(translation_error(rig.last_pose(), walk(k)), 1e-5) << "frame " << k;
+    EXPECT_LT(rotation_error(rig.last_pose(), walk(k)), 1e-5) << "frame " << k;
+  }
+}
+
+TEST(Tracker, ReportsLostWhenTheImageContentDisappears) {
+  const auto world = scene();
+  Rig rig;
+  for (int k = 0; k <= 2; ++k) ASSERT_TRUE(rig.tracker.track(world.observe(walk(k), k).data).tracked);
+  const TrackResult lost = rig.tracker.track(blank_frame(3));
+  EXPECT_EQ(lost.state, TrackingState::kLost);
+  EXPECT_FALSE(lost.tracked);
+  EXPECT_FALSE(lost.keyframe);
+  EXPECT_EQ(rig.tracker.lost_events(), 1);
+  EXPECT_FALSE(rig.tracker.records().back().tracked);
+  // Still nothing: still lost, and no second loss event.
+  EXPECT_EQ(rig.tracker.track(blank_frame(4)).state, TrackingState::kLost);
+  EXPECT_EQ(rig.tracker.lost_events(), 1);
+}
+
+TEST(Tracker, WithoutPlaceRecognitionALostCameraStartsANewMapSegment) {
+  const auto world = scene();
+  Rig rig;
+  for (int k = 0; k <= 2; ++k) ASSERT_TRUE(rig.tracker.track(world.observe(walk(k), k).data).tracked);
+  ASSERT_EQ(rig.tracker.track(blank_frame(3)).state, TrackingState::kLost);
+  const TrackResult back = rig.tracker.track(world.observe(walk(4), 4).data);
+  EXPECT_EQ(back.state, TrackingState::kOk);
+  EXPECT_TRUE(back.new_map_segment);
+  EXPECT_TRUE(back.keyframe);
+  EXPECT_EQ(rig.tracker.new_segment_frames(), std::vector<long>{4});
+  // The new segment's first keyframe is not the map's origin: that stays the first one.
+  ASSERT_GE(rig.inserted.size(), 2u);
+  EXPECT_TRUE(rig.inserted.front()->is_origin());
+  EXPECT_FALSE(rig.inserted.back()->is_origin());
+  EXPECT_EQ(rig.map.first_keyframe(), rig.inserted.front());
+}
+
+}  // namespace tracker_test
+}  // namespace plslam::tracking
