@@ -131,6 +131,8 @@ void check_increasing(const std::vector<double>& t, const fs::path& file) {
   }
 }
 
+}  // namespace detail
+
 void validate_calibration(const StereoCalibration& c, const fs::path& file) {
   const double v[] = {c.fx, c.fy, c.cx, c.cy, c.baseline};
   for (double x : v) {
@@ -143,5 +145,4 @@ void validate_calibration(const StereoCalibration& c, const fs::path& file) {
   }
 }
 
-}  // namespace detail
 }  // namespace plslam::io

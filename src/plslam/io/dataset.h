@@ -82,6 +82,10 @@ class Dataset {
   Eigen::Matrix3d R_rect_sensor_ = Eigen::Matrix3d::Identity();
 };
 
+// InputError(file, ...) unless the calibration holds finite intrinsics, positive focal lengths and
+// a positive baseline (the image size is not checked: a KITTI calib.txt does not hold it).
+void validate_calibration(const StereoCalibration& c, const std::filesystem::path& file);
+
 // Opens a KITTI odometry sequence folder (sequences/NN) or an EuRoC/ASL sequence (<seq> or
 // <seq>/mav0). Throws InputError with the offending file and problem on bad input.
 std::unique_ptr<Dataset> open_dataset(const std::filesystem::path& path,

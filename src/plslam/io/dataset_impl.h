@@ -16,7 +16,4 @@ std::pair<std::size_t, std::size_t> select_range(std::size_t total, const Datase
 // Throws InputError(file, "timestamps not increasing ...") unless strictly increasing.
 void check_increasing(const std::vector<double>& t, const std::filesystem::path& file);
 
-// Fails unless the calibration holds finite, positive focal lengths and a positive baseline.
-void validate_calibration(const StereoCalibration& c, const std::filesystem::path& file);
-
 }  // namespace plslam::io::detail

@@ -42,15 +42,13 @@ TrackingState public_state(tracking::TrackingState s) {
   return TrackingState::kLost;
 }
 
+// The intrinsics as every dataset reader checks them, plus the image size a reader takes from the
+// images but a caller states.
 void check_calibration(const StereoCalibration& c) {
-  const bool ok = c.width > 0 && c.height > 0 && std::isfinite(c.fx) && c.fx > 0 && std::isfinite(c.fy) &&
-                  c.fy > 0 && std::isfinite(c.cx) && std::isfinite(c.cy) && std::isfinite(c.baseline) &&
-                  c.baseline > 0;
-  if (!ok) {
-    throw InputError("", fmt::format("calibration: width, height, fx, fy and baseline must be positive and finite "
-                                     "(got {}x{}, fx {}, fy {}, baseline {})",
-                                     c.width, c.height, c.fx, c.fy, c.baseline));
+  if (c.width <= 0 || c.height <= 0) {
+    throw InputError("", fmt::format("calibration: the image size must be positive, got {}x{}", c.width, c.height));
   }
+  io::validate_calibration(c, "");
 }
 
 system::SystemOptions system_options(const SlamOptions& o) {
@@ -88,15 +86,7 @@ cv::Mat grey_image(const cv::Mat& image, const char* side, const StereoCalibrati
 
 }  // namespace
 
-StereoCalibration read_calibration(const std::filesystem::path& file) {
-  auto c = io::read_calibration_file(file);
-  try {
-    check_calibration(c);
-  } catch (const InputError& e) {
-    throw InputError(file.string(), e.problem());
-  }
-  return c;
-}
+StereoCalibration read_calibration(const std::filesystem::path& file) { return io::read_calibration_file(file); }
 
 struct Sequence::Impl {
   std::unique_ptr<io::Dataset> dataset;
@@ -134,7 +124,7 @@ TrajectoryErrors evaluate_trajectory(const Trajectory& ground_truth, const Traje
 }
 
 struct Slam::Impl {
-  Impl(const StereoCalibration& c, const SlamOptions& o) : calib(c), options(o) {
+  Impl(const StereoCalibration& c, const SlamOptions& o) : calib(c) {
     // spdlog's own default logger writes to stdout, which belongs to the embedding program: unless
     // the program installed a logger of its own, plslam's messages go to stderr.
     if (spdlog::default_logger()->name().empty()) init_logging(LogLevel::kInfo);
@@ -145,7 +135,6 @@ struct Slam::Impl {
   }
 
   StereoCalibration calib;
-  SlamOptions options;
   std::shared_ptr<const place::Vocabulary> vocabulary;
   std::unique_ptr<system::System> slam;
   long frames = 0;
