@@ -54,9 +54,11 @@ class LoopRun : public ::testing::Test {
     EXPECT_GE(stats["global_ba_runs"].get<int>(), 1);
     EXPECT_EQ(stats["global_ba_ms"].size(), stats["global_ba_runs"].get<std::size_t>());
     EXPECT_EQ(stats["loop_correction_ms"].size(), stats["loops"].size());
-    // A sanity bound, not the loop's gain: with loop closing 0.008-0.017 m (5 runs, 2 of them on
-    // one core shared with a busy loop; 0.0163 once under ASan), without it 0.013-0.019.
-    EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.02)
+    // A sanity bound against a wrong correction (decimetres), not the loop's gain, which the
+    // deterministic sequential test bounds. A concurrent run's map depends on thread timing: with
+    // loop closing 0.0097-0.0184 m in 3 Release runs on 2 cores and 0.009-0.011 on one, but under
+    // ASan, with 57 keyframes instead of 65-68, 0.0163, 0.0200 and 0.028 in CI runs.
+    EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.04)
         << "keyframes " << stats["keyframes"] << ", lost " << stats["lost_events"] << ", relocalizations "
         << stats["relocalizations"].dump() << ", loops " << stats["loops"].dump();
   }
@@ -78,6 +80,9 @@ TEST_F(LoopRun, SequentialRunsWithALoopAreIdentical) {
   auto a = run(out.path() / "a", " --sequential");
   auto b = run(out.path() / "b", " --sequential");
   expect_true_loops(a);
+  // The loop's gain where it is reproducible: 0.0076 m with loop closing, 0.0114 without (Release,
+  // 109 and 123 keyframes).
+  EXPECT_LT(a["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.0095);
   for (auto* s : {&a, &b}) {
     for (auto& l : (*s)["loops"]) l.erase("correction_ms");  // timings differ
   }
