@@ -37,7 +37,13 @@ done
 #                                                     the same code as RunEndToEnd, which runs here
 #   LoopRun.SequentialRunsWithALoopAreIdentical      likewise, with loop closing; the loop itself
 #                                                     runs here in LoopClosingConcurrent
-SANITIZER_SKIP='^(RunEndToEnd\.(CorridorLinesLowerTheFrameToFrameError|Kitti01HighwayIsTrackedWithinBound|SyntheticStreetTurnIsTracked)|RunDeterminism\.Sequential(Kitti|Rendered)RunsAreByteIdentical|LoopRun\.SequentialRunsWithALoopAreIdentical)$'
+#   BenchSlamCli.QuickPreset...                       8 sequential runs of one office render (230 s
+#                                                     under ASan); the bench's own code runs here in
+#                                                     the other BenchSlamCli tests
+#   RunVideo.ASyntheticVideoTracksLikeItsImageFolders two 120-frame sequential runs (160 s under
+#                                                     ASan); video decoding runs here in
+#                                                     RunVideo.AVideoPlayedAsACamera... and VideoDataset
+SANITIZER_SKIP='^(RunEndToEnd\.(CorridorLinesLowerTheFrameToFrameError|Kitti01HighwayIsTrackedWithinBound|SyntheticStreetTurnIsTracked)|RunDeterminism\.Sequential(Kitti|Rendered)RunsAreByteIdentical|LoopRun\.SequentialRunsWithALoopAreIdentical|BenchSlamCli\.QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequentialRunsDo|RunVideo\.ASyntheticVideoTracksLikeItsImageFolders)$'
 # ThreadSanitizer runs the tests whose code under test starts threads of plslam's own: the worker
 # pool and the BA that uses it, the map snapshot taken beside a writer (MapSnapshotConcurrent), the stereo extraction tasks, the image prefetch thread, synth's
 # parallel rendering, `plslam run` in the default concurrent mode (tracking + local mapping +
