@@ -45,7 +45,8 @@ done
 #                                                     RunVideo.AVideoPlayedAsACamera... and VideoDataset
 SANITIZER_SKIP='^(RunEndToEnd\.(CorridorLinesLowerTheFrameToFrameError|Kitti01HighwayIsTrackedWithinBound|SyntheticStreetTurnIsTracked)|RunDeterminism\.Sequential(Kitti|Rendered)RunsAreByteIdentical|LoopRun\.SequentialRunsWithALoopAreIdentical|BenchSlamCli\.QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequentialRunsDo|RunVideo\.ASyntheticVideoTracksLikeItsImageFolders)$'
 # ThreadSanitizer runs the tests whose code under test starts threads of plslam's own: the worker
-# pool and the BA that uses it, the map snapshot taken beside a writer (MapSnapshotConcurrent), the stereo extraction tasks, the image prefetch thread, synth's
+# pool and the BA that uses it, the local mapper's thread with its pause and abort
+# (LocalMapperThread), the map snapshot taken beside a writer (MapSnapshotConcurrent), the stereo extraction tasks, the image prefetch thread, synth's
 # parallel rendering, `plslam run` in the default concurrent mode (tracking + local mapping +
 # prefetch), and the robustness suites that run a threaded command (the image prefetch of
 # `plslam run`, synth and bench stopped by a signal), the keyframe database (local mapping adds,
@@ -55,12 +56,12 @@ SANITIZER_SKIP='^(RunEndToEnd\.(CorridorLinesLowerTheFrameToFrameError|Kitti01Hi
 # other two stages. The sequential end-to-end accuracy runs
 # are left to the other stages: in them local mapping runs in the tracking thread, and
 # RunConcurrent covers every seam between the threads.
-TSAN_SUITES='WorkerPool|MapSnapshotConcurrent|BundleAdjustment|StereoPoints|FrameStream|LiveCapture|VideoDataset|SynthFormats|SynthDeterminism|RunConcurrent|TimeRobustness|SignalRobustness|KeyframeDatabase|RelocalizationConcurrent|LoopClosingConcurrent'
+TSAN_SUITES='WorkerPool|LocalMapperThread|MapSnapshotConcurrent|BundleAdjustment|StereoPoints|FrameStream|LiveCapture|VideoDataset|SynthFormats|SynthDeterminism|RunConcurrent|TimeRobustness|SignalRobustness|KeyframeDatabase|RelocalizationConcurrent|LoopClosingConcurrent'
 TSAN_TESTS="^(${TSAN_SUITES})\\."
 # The test executables that hold them (tests/<folder> -> test_<folder>), plus the CLI they run: the
 # TSan stage builds only these. A TSan suite in another folder stops the script (checked below),
 # so no test can drop out of the stage silently.
-TSAN_TARGETS='plslam test_core test_features test_io test_loop test_map test_optim test_place test_robustness test_synth test_system'
+TSAN_TARGETS='plslam test_core test_features test_io test_loop test_map test_mapping test_optim test_place test_robustness test_synth test_system'
 for f in $(grep -rlE "^(TEST|TEST_F|TEST_P)\((${TSAN_SUITES})[A-Za-z]*," tests); do
   folder=$(echo "$f" | cut -d/ -f2)
   case " $TSAN_TARGETS " in

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 
 #include "plslam/mapping/local_ba_window.h"
 #include "support/synthetic_views.h"
@@ -148,6 +149,26 @@ TEST(LocalBaWindow, MovesAPerturbedKeyframeBackAndLeavesTheFixedOnes) {
     EXPECT_LT((c.m.point[w]->position() - c.m.world.points[static_cast<std::size_t>(w)]).norm(), 1e-4) << w;
     EXPECT_EQ(c.m.point[w]->num_observations(), w < 20 || w >= 40 ? 2 : 3);  // no observation lost
   }
+}
+
+// The abort seam: a flag raised before the solver's first iteration leaves the state where it
+// started, and the result, written back all the same, says it was cut short.
+TEST(LocalBaWindow, AnAbortRaisedBeforeTheFirstIterationWritesBackTheStartAndSaysSo) {
+  Chain c;
+  c.connect();
+  const geometry::SE3 truth2 = c.kf[2]->pose();
+  const geometry::SE3 perturbed = geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.002, 0, 0)) * truth2;
+  c.kf[2]->set_pose(perturbed);
+  const std::atomic<bool> abort{true};
+  bool aborted = false;
+  ASSERT_TRUE(run_local_ba(c.m.map, *c.kf[3], LocalBaOptions{}, &abort, &aborted));
+  EXPECT_TRUE(aborted);
+  EXPECT_EQ(c.kf[2]->pose().matrix(), perturbed.matrix());
+
+  const std::atomic<bool> go_on{false};
+  ASSERT_TRUE(run_local_ba(c.m.map, *c.kf[3], LocalBaOptions{}, &go_on, &aborted));
+  EXPECT_FALSE(aborted);
+  EXPECT_LT((c.kf[2]->camera_center() - truth2.inverse().translation()).norm(), 1e-4);
 }
 
 TEST(LocalBaWindow, NothingToOptimiseWithoutObservations) {

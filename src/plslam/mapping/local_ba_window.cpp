@@ -55,7 +55,8 @@ void write_back_local_ba(const MapBaProblem& window, const optim::BaResult& resu
   }
 }
 
-bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o) {
+bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o, const std::atomic<bool>* abort,
+                  bool* aborted) {
   const MapBaProblem window = local_ba_window(kf, o);
   if (window.problem.point_observations.empty()) return false;
   optim::BaOptions ba;
@@ -63,8 +64,10 @@ bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o) {
   ba.second_pass_iterations = o.second_iterations;
   ba.scale_factor = kf.data().scale_factor;
   ba.linear_solver = optim::BaLinearSolver::kSparseSchur;
+  ba.abort = abort;
   const geometry::StereoCamera cam(kf.data().calib);
   const auto result = optim::local_bundle_adjustment(cam, window.problem, ba);
+  if (aborted) *aborted = result.aborted;
   if (!result.usable) {
     spdlog::debug("local BA unusable: {}", result.message);
     return false;

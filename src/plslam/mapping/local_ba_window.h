@@ -2,6 +2,8 @@
 // Local bundle adjustment around a new keyframe (ORB-SLAM2's LocalBundleAdjustment, with lines):
 // which keyframes and landmarks it optimises, which keyframes stay fixed, and how the result goes
 // back into the map.
+#include <atomic>
+
 #include "plslam/map/map.h"
 #include "plslam/mapping/map_ba_problem.h"
 #include "plslam/optim/bundle_adjustment.h"
@@ -29,7 +31,10 @@ MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o);
 void write_back_local_ba(const MapBaProblem& window, const optim::BaResult& result);
 
 // Builds the window of `kf`, optimises it and writes the result back under the map's update
-// mutex. False when there was nothing to optimise or the solver's result was unusable.
-bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o);
+// mutex. False when there was nothing to optimise or the solver's result was unusable. `abort`
+// (may be null), raised from another thread, stops the solver after its current iteration; the
+// partial result is written back and `*aborted` (may be null) says so.
+bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o,
+                  const std::atomic<bool>* abort = nullptr, bool* aborted = nullptr);
 
 }  // namespace plslam::mapping

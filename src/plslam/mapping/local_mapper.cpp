@@ -44,14 +44,23 @@ void LocalMapper::insert(map::KeyFrame* kf) {
   {
     std::lock_guard lock(queue_mutex_);
     queue_.push_back(kf);
+    // With process_pending(), busy_ is never seen here: it runs in the inserting thread.
+    if (busy_ && options_.abort_ba_on_new_keyframe) abort_ba_ = true;
   }
   cv_.notify_all();
 }
 
+void LocalMapper::abort_ba() { abort_ba_ = true; }
+
 void LocalMapper::pause() {
+  const auto t0 = Clock::now();
   std::unique_lock lock(queue_mutex_);
   ++pauses_;
+  if (busy_) abort_ba_ = true;
   cv_.wait(lock, [this] { return !busy_; });
+  lock.unlock();
+  std::lock_guard stats_lock(stats_mutex_);
+  stats_.pause_wait_ms.push_back(ms_since(t0));
 }
 
 void LocalMapper::resume() {
@@ -91,6 +100,7 @@ void LocalMapper::process_front(std::unique_lock<std::mutex>& lock) {
   queue_.pop_front();
   const bool more = !queue_.empty();
   busy_ = true;
+  abort_ba_ = false;  // an abort meant for the previous keyframe's BA
   lock.unlock();
   process(kf, more);
   lock.lock();
@@ -131,7 +141,8 @@ void LocalMapper::process(map::KeyFrame* kf, bool more_waiting) {
     t = Clock::now();
     fuse(kf);
     fusion_ms = ms_since(t);
-    if (options_.local_ba && map_.num_keyframes() > 2) local_bundle_adjustment(kf);
+    // An abort raised before the BA starts (a pause, a newer keyframe) skips it.
+    if (options_.local_ba && map_.num_keyframes() > 2 && !abort_ba_) local_bundle_adjustment(kf);
     cull_keyframes(kf);
   }
   {
@@ -187,9 +198,11 @@ void LocalMapper::fuse(map::KeyFrame* kf) {
 
 void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf) {
   const auto t0 = Clock::now();
-  if (!run_local_ba(map_, *kf, options_.ba)) return;
+  bool aborted = false;
+  if (!run_local_ba(map_, *kf, options_.ba, &abort_ba_, &aborted)) return;
   std::lock_guard stats_lock(stats_mutex_);
   stats_.local_ba_ms.push_back(ms_since(t0));
+  stats_.aborted_local_ba += aborted;
 }
 
 void LocalMapper::cull_keyframes(map::KeyFrame* kf) {

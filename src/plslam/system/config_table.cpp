@@ -182,6 +182,8 @@ std::vector<ConfigKey> make_table() {
           "weight of line residuals against point residuals (tracking, local and global BA)", positive()),
 
     field("mapping", "local_ba", [](auto& o) -> auto& { return o.mapper.local_ba; }, "local bundle adjustment"),
+    field("mapping", "abort_ba_on_new_keyframe", [](auto& o) -> auto& { return o.mapper.abort_ba_on_new_keyframe; },
+          "a keyframe queued during local BA cuts it short (mapping thread only)"),
     field("mapping", "ba_iterations", [](auto& o) -> auto& { return o.mapper.ba.iterations; },
           "local BA: iterations of the robust first pass"),
     field("mapping", "culling_redundancy", [](auto& o) -> auto& { return o.mapper.keyframe_culling.redundancy; },

@@ -139,6 +139,10 @@ nlohmann::json RunReport::to_json(const System& slam) const {
            {{"keyframe", percentile(ms.keyframe_ms, 0.5)},
             {"triangulation", percentile(ms.triangulation_ms, 0.5)},
             {"fusion", percentile(ms.fusion_ms, 0.5)}}},
+          {"aborted_local_ba", ms.aborted_local_ba},
+          {"mapping_pause_wait_ms", {{"median", percentile(ms.pause_wait_ms, 0.5)},
+                                     {"max", ms.pause_wait_ms.empty() ? 0.0 : *std::max_element(ms.pause_wait_ms.begin(), ms.pause_wait_ms.end())},
+                                     {"count", ms.pause_wait_ms.size()}}},
           {"culled_keyframes", ms.culled_keyframes},
           {"triangulated_points", ms.triangulated_points}};
 }

@@ -1,0 +1,84 @@
+// The local mapper's thread seams: pause() waits for the keyframe in progress and is counted, an
+// abort is meant for the BA in progress only, and process_pending() is untouched by either. The
+// map: four keyframes 0.3 m apart sharing 60 points at 3 m, the third one's pose perturbed, so
+// that local BA around the fourth has something to correct.
+#include <gtest/gtest.h>
+
+#include "plslam/mapping/local_mapper.h"
+#include "support/synthetic_views.h"
+
+namespace plslam::mapping {
+namespace local_mapper_test {
+
+using test::camera_at;
+using test::range;
+
+struct Row {
+  test::SyntheticMap m;
+  std::vector<map::KeyFrame*> kf;
+  geometry::SE3 truth2;
+  Row() {
+    for (int i = 0; i < 60; ++i) m.world.add_point({-0.4 + 0.02 * i, -0.3 + 0.01 * i, 3.0 + 0.01 * (i % 7)});
+    for (int k = 0; k < 4; ++k) kf.push_back(m.add_keyframe(camera_at({0.3 * k, 0, 0})));
+    for (auto* k : kf) m.observe_points(k, range(0, 60));
+    truth2 = kf[2]->pose();
+    kf[2]->set_pose(geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.004, -0.003, 0.002)) * truth2);
+  }
+  double error2() const { return (kf[2]->camera_center() - truth2.inverse().translation()).norm(); }
+};
+
+LocalMapperOptions no_culling() {
+  LocalMapperOptions o;
+  o.keyframe_culling.redundancy = 1.1;  // every keyframe sees every point: keep them all
+  return o;
+}
+
+TEST(LocalMapperThread, AnAbortRaisedWhileIdleDoesNotCutTheNextKeyframesBa) {
+  Row r;
+  ASSERT_GT(r.error2(), 1e-3);
+  LocalMapper mapper(r.m.map, no_culling());
+  mapper.start();
+  mapper.abort_ba();  // nothing runs: the flag is cleared when the keyframe starts
+  mapper.insert(r.kf[3]);
+  mapper.wait_idle();
+  mapper.stop();
+  const auto st = mapper.stats();
+  EXPECT_EQ(st.local_ba_ms.size(), 1u);
+  EXPECT_EQ(st.aborted_local_ba, 0);
+  EXPECT_LT(r.error2(), 1e-4);
+}
+
+TEST(LocalMapperThread, PauseHoldsTheQueueUntilResumeAndIsTimed) {
+  Row r;
+  LocalMapper mapper(r.m.map, no_culling());
+  mapper.start();
+  mapper.pause();
+  mapper.insert(r.kf[3]);
+  EXPECT_EQ(mapper.queued(), 1u);  // paused: it waits
+  EXPECT_GT(r.error2(), 1e-3);
+  mapper.resume();
+  mapper.wait_idle();
+  mapper.stop();
+  const auto st = mapper.stats();
+  ASSERT_EQ(st.pause_wait_ms.size(), 1u);
+  EXPECT_GE(st.pause_wait_ms[0], 0.0);
+  EXPECT_EQ(st.local_ba_ms.size(), 1u);
+  EXPECT_LT(r.error2(), 1e-4);
+}
+
+// Deterministic mode: the caller's thread runs the keyframe; an abort raised before has no effect.
+TEST(LocalMapperSequential, ProcessPendingRunsTheFullBaWhateverWasRaisedBefore) {
+  Row r;
+  LocalMapper mapper(r.m.map, no_culling());
+  mapper.abort_ba();
+  mapper.insert(r.kf[3]);
+  mapper.process_pending();
+  const auto st = mapper.stats();
+  EXPECT_EQ(st.local_ba_ms.size(), 1u);
+  EXPECT_EQ(st.aborted_local_ba, 0);
+  EXPECT_TRUE(st.pause_wait_ms.empty());
+  EXPECT_LT(r.error2(), 1e-4);
+}
+
+}  // namespace local_mapper_test
+}  // namespace plslam::mapping
