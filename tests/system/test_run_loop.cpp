@@ -55,9 +55,10 @@ class LoopRun : public ::testing::Test {
     EXPECT_EQ(stats["global_ba_ms"].size(), stats["global_ba_runs"].get<std::size_t>());
     EXPECT_EQ(stats["loop_correction_ms"].size(), stats["loops"].size());
     // A sanity bound against a wrong correction (decimetres), not the loop's gain, which the
-    // deterministic sequential test bounds. A concurrent run's map depends on thread timing: with
-    // loop closing 0.0097-0.0184 m in 3 Release runs on 2 cores and 0.009-0.011 on one, but under
-    // ASan, with 57 keyframes instead of 65-68, 0.0163, 0.0200 and 0.028 in CI runs.
+    // deterministic sequential test bounds. A concurrent run's map depends on thread timing: 60
+    // runs, 4 at a time on 2 cores: median 0.0094 m, p90 0.0116, max 0.0207 (before global BA
+    // gated its outliers and the motion model retried wide on few matches: max 0.053, 5 above
+    // 0.02). CI's ASan stage, with 57 keyframes instead of 65-70, measured 0.0163, 0.0200, 0.028.
     EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.04)
         << "keyframes " << stats["keyframes"] << ", lost " << stats["lost_events"] << ", relocalizations "
         << stats["relocalizations"].dump() << ", loops " << stats["loops"].dump();
@@ -80,8 +81,7 @@ TEST_F(LoopRun, SequentialRunsWithALoopAreIdentical) {
   auto a = run(out.path() / "a", " --sequential");
   auto b = run(out.path() / "b", " --sequential");
   expect_true_loops(a);
-  // The loop's gain where it is reproducible: 0.0076 m with loop closing, 0.0114 without (Release,
-  // 109 and 123 keyframes).
+  // The loop's gain where it is reproducible: 0.0069 m with loop closing, 0.0171 without (Release).
   EXPECT_LT(a["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.0095);
   for (auto* s : {&a, &b}) {
     for (auto& l : (*s)["loops"]) l.erase("correction_ms");  // timings differ

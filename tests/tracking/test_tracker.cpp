@@ -134,6 +134,33 @@ TEST(Tracker, FollowsAKnownSmallMotionWithLinesToo) {
   }
 }
 
+// A sudden turn with a sideways jump the motion model did not predict: 3 degrees of yaw and
+// 0.6 m to the side move each point by 400 (0.6 / z - 0.052) px, so the 7 px windows keep only
+// the far points (8.6-17 m deep): about a tenth of the last frame's matches, nearly all right. The
+// few-matches rule searches again in the wide windows; without it (and with the inlier-share
+// rule off) the motion model keeps the narrow attempt.
+int wide_retries_on_a_sudden_turn(double min_match_share) {
+  const auto world = scene();
+  TrackerOptions o;
+  o.motion_min_inlier_share = 0;
+  o.motion_min_match_share = min_match_share;
+  Rig rig(o);
+  for (int k = 0; k <= 4; ++k) EXPECT_TRUE(rig.tracker.track(world.observe(walk(k), k).data).tracked);
+  EXPECT_EQ(rig.tracker.motion_wide_retries(), 0);
+  const geometry::SE3 jump(Eigen::AngleAxisd(3 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                           Eigen::Vector3d(-0.6, 0, 0));
+  const geometry::SE3 truth = jump * walk(5);
+  const TrackResult r = rig.tracker.track(world.observe(truth, 5).data);
+  EXPECT_TRUE(r.tracked);
+  EXPECT_LT(translation_error(rig.last_pose(), truth), 1e-4);
+  return rig.tracker.motion_wide_retries();
+}
+
+TEST(Tracker, FewMotionMatchesForTheLastFramesPointsMeanASuddenTurnAndAWideSearch) {
+  EXPECT_EQ(wide_retries_on_a_sudden_turn(0.3), 1);
+  EXPECT_EQ(wide_retries_on_a_sudden_turn(0.0), 0);
+}
+
 TEST(Tracker, ReportsLostWhenTheImageContentDisappears) {
   const auto world = scene();
   Rig rig;

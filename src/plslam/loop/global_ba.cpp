@@ -33,7 +33,8 @@ GlobalBaSnapshot snapshot_for_global_ba(const map::Map& map, const GlobalBaOptio
 optim::BaResult run_global_ba(const GlobalBaSnapshot& s, const GlobalBaOptions& o, const std::atomic<bool>* abort) {
   optim::BaOptions ba;
   ba.iterations = o.iterations;
-  ba.remove_outliers = false;
+  ba.remove_outliers = o.remove_outliers;
+  ba.second_pass_iterations = o.iterations;
   ba.linear_solver = optim::BaLinearSolver::kSparseSchur;
   ba.abort = abort;
   if (!s.problem->keyframes.empty()) ba.scale_factor = s.problem->keyframes.front()->data().scale_factor;

@@ -139,6 +139,9 @@ std::vector<ConfigKey> make_table() {
     field("tracking", "motion_min_inlier_share", [](auto& o) -> auto& { return o.tracker.motion_min_inlier_share; },
           "below this share of inliers among its matches, the motion model searches again in wider windows",
           in_closed(0, 1)),
+    field("tracking", "motion_min_match_share", [](auto& o) -> auto& { return o.tracker.motion_min_match_share; },
+          "below this share of the last frame's tracked points among its matches, the motion model searches again "
+          "in wider windows", in_closed(0, 1)),
     field("tracking", "motion_retry_scale", [](auto& o) -> auto& { return o.tracker.motion_retry_scale; },
           "how much wider those windows are", at_least(1)),
     field("tracking", "min_local_inliers", [](auto& o) -> auto& { return o.tracker.min_local_inliers; },
@@ -285,7 +288,9 @@ std::vector<ConfigKey> make_table() {
     field("loop", "global_ba", [](auto& o) -> auto& { return o.loop.global_ba; },
           "global BA after each loop, in a background thread"),
     field("loop", "global_ba_iterations", [](auto& o) -> auto& { return o.loop.global_ba_options.iterations; },
-          "global BA iterations"),
+          "global BA iterations (per pass)"),
+    field("loop", "global_ba_remove_outliers", [](auto& o) -> auto& { return o.loop.global_ba_options.remove_outliers; },
+          "global BA drops the observations beyond their gate after its robust pass and runs a second pass"),
     field("loop", "finish_wait_s", [](auto& o) -> auto& { return o.loop.finish_wait_s; },
           "at the end of a run, seconds to wait for a running global BA"),
 

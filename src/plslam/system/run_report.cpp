@@ -124,6 +124,7 @@ nlohmann::json RunReport::to_json(const System& slam) const {
           {"skipped", skipped_json},
           {"untracked_kitti_lines", untracked_lines},
           {"lost_events", slam.tracker().lost_events()},
+          {"motion_wide_retries", slam.tracker().motion_wide_retries()},
           {"keyframes", slam.map().num_keyframes()},
           {"map_points", slam.map().num_points()},
           {"map_lines", slam.map().num_lines()},

@@ -293,11 +293,15 @@ bool Tracker::track_with_motion_model(Frame& f, TrackStageTimes& t) {
   // A sudden change of motion (a car entering a turn: 1 degree of unexpected yaw is 12 px on
   // KITTI) moves most true matches out of the window. The matches found are then mostly wrong,
   // and the optimisation, pulled between them, keeps few as inliers and settles on a wrong pose
-  // that local map tracking would confirm. So a low inlier share means: search again in a window
-  // wide enough for the change and keep whichever attempt explains more matches.
-  if (n >= options_.min_motion_matches && inliers < options_.motion_min_inlier_share * n) {
+  // that local map tracking would confirm. So a low inlier share, or few matches for the points
+  // the last frame tracked, means: search again in a window wide enough for the change and keep
+  // whichever attempt explains more matches.
+  const auto last_tracked = std::count_if(last_->points.begin(), last_->points.end(), [](auto* p) { return p != nullptr; });
+  const bool few_matches = n < options_.motion_min_match_share * static_cast<double>(last_tracked);
+  if (n >= options_.min_motion_matches && (inliers < options_.motion_min_inlier_share * n || few_matches)) {
     const Frame narrow = f;
     const int narrow_inliers = inliers;
+    ++motion_wide_retries_;
     attempt(options_.motion_retry_scale, inliers);
     if (inliers <= narrow_inliers) {
       f = narrow;

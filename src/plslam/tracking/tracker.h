@@ -57,6 +57,11 @@ struct TrackerOptions {
   // Motion-model tracking searches again in windows `motion_retry_scale` times wider when fewer
   // than this share of its matches survive the pose optimisation (the motion changed suddenly).
   double motion_min_inlier_share = 0.5;
+  // ... or when its matches fall below this share of the last frame's tracked points: a sudden
+  // turn moved most of them out of the windows. In a concurrent run, where local mapping lags in a
+  // fast turn, the few left (27 of 210 once, on the office loop's corner) then gave a pose 1.8 deg
+  // off that the next frames built on.
+  double motion_min_match_share = 0.3;
   double motion_retry_scale = 4.0;
   int min_motion_matches = 20;
   int min_pose_inliers = 10;
@@ -131,6 +136,8 @@ class Tracker {
   void start_in_loaded_map();
 
   int lost_events() const { return lost_events_; }
+  // Motion-model searches repeated in the wide windows (a low inlier share or few matches).
+  int motion_wide_retries() const { return motion_wide_retries_; }
   const std::vector<long>& relocalized_frames() const { return relocalized_frames_; }
   const std::vector<long>& new_segment_frames() const { return new_segment_frames_; }
   const std::vector<FrameRecord>& records() const { return records_; }
@@ -188,6 +195,7 @@ class Tracker {
   std::optional<std::size_t> last_tracked_record_;  // index into records_
   long seen_big_changes_ = 0;  // map_.big_changes() when the last frame was tracked
   int lost_events_ = 0;
+  int motion_wide_retries_ = 0;
   const place::KeyframeDatabase* database_ = nullptr;
   std::optional<double> lost_since_;  // first textured frame that failed to relocalize
   std::vector<long> relocalized_frames_;
