@@ -79,6 +79,8 @@ void RunReport::add(const FrameResult& r) {
 
 nlohmann::json RunReport::to_json(const System& slam) const {
   const auto ms = slam.mapper_stats();
+  nlohmann::json pause_wait = summarize(ms.pause_wait_ms);  // loop closing's waits for local mapping
+  pause_wait["count"] = ms.pause_wait_ms.size();
   const auto init = slam.initialized_at();
   std::vector<long> lost_ids;
   std::size_t before_init = 0;
@@ -141,9 +143,7 @@ nlohmann::json RunReport::to_json(const System& slam) const {
             {"triangulation", percentile(ms.triangulation_ms, 0.5)},
             {"fusion", percentile(ms.fusion_ms, 0.5)}}},
           {"aborted_local_ba", ms.aborted_local_ba},
-          {"mapping_pause_wait_ms", {{"median", percentile(ms.pause_wait_ms, 0.5)},
-                                     {"max", ms.pause_wait_ms.empty() ? 0.0 : *std::max_element(ms.pause_wait_ms.begin(), ms.pause_wait_ms.end())},
-                                     {"count", ms.pause_wait_ms.size()}}},
+          {"mapping_pause_wait_ms", pause_wait},
           {"culled_keyframes", ms.culled_keyframes},
           {"triangulated_points", ms.triangulated_points}};
 }

@@ -296,8 +296,7 @@ bool Tracker::track_with_motion_model(Frame& f, TrackStageTimes& t) {
   // that local map tracking would confirm. So a low inlier share, or few matches for the points
   // the last frame tracked, means: search again in a window wide enough for the change and keep
   // whichever attempt explains more matches.
-  const auto last_tracked = std::count_if(last_->points.begin(), last_->points.end(), [](auto* p) { return p != nullptr; });
-  const bool few_matches = n < options_.motion_min_match_share * static_cast<double>(last_tracked);
+  const bool few_matches = n < options_.motion_min_match_share * last_->num_matched_points();
   if (n >= options_.min_motion_matches && (inliers < options_.motion_min_inlier_share * n || few_matches)) {
     const Frame narrow = f;
     const int narrow_inliers = inliers;
