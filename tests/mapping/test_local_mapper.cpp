@@ -66,6 +66,25 @@ TEST(LocalMapperThread, PauseHoldsTheQueueUntilResumeAndIsTimed) {
   EXPECT_LT(r.error2(), 1e-4);
 }
 
+// The longest queue is what a growing backlog would show (issue 19): two keyframes wait while
+// mapping is paused, and only the last one, with nothing behind it, gets the local BA.
+TEST(LocalMapperThread, TheLongestQueueIsCounted) {
+  Row r;
+  LocalMapper mapper(r.m.map, no_culling());
+  mapper.start();
+  mapper.pause();
+  mapper.insert(r.kf[2]);
+  mapper.insert(r.kf[3]);
+  EXPECT_EQ(mapper.queued(), 2u);
+  mapper.resume();
+  mapper.wait_idle();
+  mapper.stop();
+  const auto st = mapper.stats();
+  EXPECT_EQ(st.max_queue, 2);
+  EXPECT_EQ(st.keyframe_ms.size(), 2u);
+  EXPECT_EQ(st.local_ba_ms.size(), 1u);  // the first one had another waiting: no BA
+}
+
 // Deterministic mode: the caller's thread runs the keyframe; an abort raised before has no effect.
 TEST(LocalMapperSequential, ProcessPendingRunsTheFullBaWhateverWasRaisedBefore) {
   Row r;
@@ -77,6 +96,7 @@ TEST(LocalMapperSequential, ProcessPendingRunsTheFullBaWhateverWasRaisedBefore) 
   EXPECT_EQ(st.local_ba_ms.size(), 1u);
   EXPECT_EQ(st.aborted_local_ba, 0);
   EXPECT_TRUE(st.pause_wait_ms.empty());
+  EXPECT_EQ(st.max_queue, 1);
   EXPECT_LT(r.error2(), 1e-4);
 }
 

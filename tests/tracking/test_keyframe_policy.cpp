@@ -186,12 +186,34 @@ TEST(KeyframePolicy, CloseDepthNeedTriggersKeyframe) {
   EXPECT_EQ(d.reason, KeyframeReason::kCloseDepth);
 }
 
+// A keyframe the rules want is not made while max_queued keyframes wait for local mapping, and
+// the decision says why; one fewer waiting and it is made.
+TEST(KeyframePolicy, AFullMappingQueueHoldsTheKeyframeBack) {
+  for (int queued : {3, 2}) {
+    KeyframePolicyOptions o;
+    o.kalman = false;
+    KeyframePolicy policy(o);
+    auto in = frame(2, 0.1, 0, 390, 400);
+    in.tracked_close = 50;
+    in.untracked_close = 120;  // the close-depth rule fires whether mapping is idle or not
+    in.local_mapping_idle = false;
+    in.keyframes_queued = queued;
+    const auto d = policy.decide(in);
+    EXPECT_EQ(d.insert, queued < 3) << queued;
+    EXPECT_EQ(d.queue_full, queued == 3) << queued;
+    EXPECT_EQ(d.reason, queued < 3 ? KeyframeReason::kCloseDepth : KeyframeReason::kNone) << queued;
+  }
+}
+
 TEST(KeyframePolicy, RejectsInvalidOptions) {
   KeyframePolicyOptions o;
   o.ratio = 1.5;
   EXPECT_THROW(o.validate(), InputError);
   o = {};
   o.max_speed = -1;
+  EXPECT_THROW(o.validate(), InputError);
+  o = {};
+  o.max_queued = 0;
   EXPECT_THROW(o.validate(), InputError);
 }
 

@@ -183,6 +183,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   std::size_t reached = 0;  // input frames before the one the run stopped at
   std::size_t done = 0;
   std::unique_ptr<io::LiveCapture> live;
+  std::vector<double> realtime_lag_ms;  // --realtime: per frame, how late its processing started
   auto process = [&](const io::StereoFrame& frame) {
     const auto r = slam.process(frame);
     report.add(r);
@@ -209,10 +210,15 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
         report.complete = true;
         break;
       }
-      if (args.realtime && done > 0) {
-        // Pace the input at the dataset's rate, as a live camera would deliver it.
+      if (args.realtime) {
+        // Pace the input at the dataset's rate, as a live camera would deliver it. A frame that
+        // starts after its time has come is late by the lag: the run is behind real time.
         const double t_rel = frame->timestamp - ds->timestamps().front();
-        std::this_thread::sleep_until(start + std::chrono::duration<double>(t_rel));
+        const auto due = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                     std::chrono::duration<double>(t_rel));
+        std::this_thread::sleep_until(due);
+        realtime_lag_ms.push_back(
+            std::max(0.0, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - due).count()));
       }
       process(*frame);
     }
@@ -259,6 +265,12 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
                      "came)",
                 live->name(), live->captured(), live->taken(), live->dropped());
   }
+  nlohmann::json realtime_stats = nullptr;
+  if (args.realtime && ds) {
+    realtime_stats = system::realtime_json(realtime_lag_ms, ds->fps());
+    spdlog::log(realtime_stats["frames_late"].get<long>() > 0 ? spdlog::level::warn : spdlog::level::info, "{}",
+                system::realtime_summary(realtime_stats));
+  }
   for (auto& s : stream ? stream->skipped_frames() : std::vector<io::SkippedFrame>{}) {
     // Frames skipped before the stopping point belong to this run; the reader may have run ahead.
     if (s.index < reached) report.skipped.push_back(std::move(s));
@@ -292,6 +304,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     stats_out = with_interruption(report.to_json(slam));
     stats_out["map"] = map_stats;
     stats_out["live"] = live_stats;
+    stats_out["realtime"] = realtime_stats;
     const auto stats_text = stats_out.dump(2);
     io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats_text << "\n"; });
     if (!fatal.empty()) throw InputError("", fatal);
@@ -334,6 +347,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   auto stats = with_interruption(report.to_json(slam));
   stats["map"] = map_stats;
   stats["live"] = live_stats;
+  stats["realtime"] = realtime_stats;
   if (ds && ds->ground_truth()) {
     // Tracked poses only: a prediction made while lost is not an estimate to score.
     try {

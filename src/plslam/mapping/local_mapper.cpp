@@ -2,6 +2,7 @@
 
 #include "plslam/core/stopwatch.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include "plslam/place/keyframe_database.h"
@@ -41,13 +42,17 @@ void LocalMapper::stop() {
 }
 
 void LocalMapper::insert(map::KeyFrame* kf) {
+  std::size_t waiting = 0;
   {
     std::lock_guard lock(queue_mutex_);
     queue_.push_back(kf);
+    waiting = queue_.size();
     // With process_pending(), busy_ is never seen here: it runs in the inserting thread.
     if (busy_ && options_.abort_ba_on_new_keyframe) abort_ba_ = true;
   }
   cv_.notify_all();
+  std::lock_guard stats_lock(stats_mutex_);
+  stats_.max_queue = std::max(stats_.max_queue, static_cast<int>(waiting));
 }
 
 void LocalMapper::abort_ba() { abort_ba_ = true; }

@@ -54,6 +54,10 @@ struct LocalMapperStats {
   std::vector<double> fusion_ms;         // per keyframe that ran it
   int culled_keyframes = 0;
   int aborted_local_ba = 0;              // cut short by abort_ba(), pause() or a new keyframe
+  // The most keyframes ever waiting in the queue (the one being processed not counted), each
+  // insert() included: 1 when mapping always kept up. A queue that grows means mapping cannot
+  // keep up, and the keyframes waiting skip fusion and local BA (process()).
+  int max_queue = 0;
   std::vector<double> pause_wait_ms;     // per pause(): the wait for the keyframe in progress
   int triangulated_points = 0;
   int fused_points = 0;

@@ -180,6 +180,8 @@ std::vector<ConfigKey> make_table() {
           "m/s: faster motion forces a keyframe"),
     field("keyframe", "velocity_min_frames", [](auto& o) -> auto& { return o.tracker.keyframe.velocity_min_frames; },
           "the velocity rule fires at most every this many frames"),
+    field("keyframe", "max_queued", [](auto& o) -> auto& { return o.tracker.keyframe.max_queued; },
+          "no new keyframe while this many wait for local mapping"),
 
     field("optim", "line_information", [](auto& o) -> auto& { return o.tracker.line_information; },
           "weight of line residuals against point residuals (tracking, local and global BA)", positive()),

@@ -81,6 +81,16 @@ nlohmann::json RunReport::to_json(const System& slam) const {
   const auto ms = slam.mapper_stats();
   nlohmann::json pause_wait = summarize(ms.pause_wait_ms);  // loop closing's waits for local mapping
   pause_wait["count"] = ms.pause_wait_ms.size();
+  // Local mapping's throughput: keyframes per second of its own busy time (what it could take),
+  // and the longest queue it ever had (1: it always kept up).
+  double busy_ms = 0;
+  for (double t : ms.keyframe_ms) busy_ms += t;
+  const nlohmann::json local_mapping = {
+      {"keyframes_processed", ms.keyframe_ms.size()},
+      {"keyframe_ms", summarize(ms.keyframe_ms)},
+      {"keyframes_per_busy_s", busy_ms > 0 ? nlohmann::json(1000.0 * ms.keyframe_ms.size() / busy_ms) : nullptr},
+      {"max_queue", ms.max_queue},
+      {"keyframes_refused_queue_full", slam.tracker().keyframes_refused_queue_full()}};
   const auto init = slam.initialized_at();
   std::vector<long> lost_ids;
   std::size_t before_init = 0;
@@ -142,6 +152,7 @@ nlohmann::json RunReport::to_json(const System& slam) const {
            {{"keyframe", percentile(ms.keyframe_ms, 0.5)},
             {"triangulation", percentile(ms.triangulation_ms, 0.5)},
             {"fusion", percentile(ms.fusion_ms, 0.5)}}},
+          {"local_mapping", local_mapping},
           {"aborted_local_ba", ms.aborted_local_ba},
           {"mapping_pause_wait_ms", pause_wait},
           {"culled_keyframes", ms.culled_keyframes},
@@ -157,6 +168,22 @@ std::string RunReport::summary(const System& slam) const {
       slam.tracker().new_segment_frames().size(), slam.loop_closer() ? slam.loop_closer()->stats().loops.size() : 0,
       slam.map().num_keyframes(), slam.map().num_points(),
       slam.map().num_lines(), percentile(tracking_ms, 0.5), mean(tracking_ms), percentile(tracking_ms, 0.9));
+}
+
+nlohmann::json realtime_json(const std::vector<double>& lag_ms, double fps) {
+  const double period_ms = fps > 0 ? 1000.0 / fps : 0.0;
+  const auto late = std::count_if(lag_ms.begin(), lag_ms.end(), [&](double lag) { return lag > period_ms; });
+  return {{"rate_hz", fps}, {"frames", lag_ms.size()}, {"frames_late", late}, {"lag_ms", summarize(lag_ms)}};
+}
+
+std::string realtime_summary(const nlohmann::json& realtime) {
+  const auto& lag = realtime["lag_ms"];
+  if (lag["max"].is_null()) return fmt::format("real time at {:.1f} Hz: no frame processed", realtime["rate_hz"].get<double>());
+  return fmt::format("real time at {:.1f} Hz: {} of {} frames late by more than a frame period "
+                     "(lag median {:.1f} ms, p90 {:.1f}, max {:.1f})",
+                     realtime["rate_hz"].get<double>(), realtime["frames_late"].get<long>(),
+                     realtime["frames"].get<long>(), lag["median"].get<double>(), lag["p90"].get<double>(),
+                     lag["max"].get<double>());
 }
 
 nlohmann::json evaluate_against_ground_truth(const io::Dataset& dataset, const Trajectory& estimate) {

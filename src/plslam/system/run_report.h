@@ -34,6 +34,14 @@ struct RunReport {
   std::string summary(const System& slam) const;
 };
 
+// `plslam run --realtime`: how far behind real time the run fell. lag_ms holds, per frame, how
+// late its processing started after the time the frame was due (0 when on time). A frame is late
+// when it starts more than one frame period (1/fps) after it was due: a live camera would have
+// delivered the next frame by then. {rate_hz, frames, frames_late, lag_ms: {median, p90, mean, max}}.
+nlohmann::json realtime_json(const std::vector<double>& lag_ms, double fps);
+// One line for the log: "real time at 20.0 Hz: 3 of 480 frames late (...)".
+std::string realtime_summary(const nlohmann::json& realtime);
+
 // ATE (se3 alignment) and RPE (1 frame) of the trajectory against the dataset's ground truth,
 // through the eval library.
 nlohmann::json evaluate_against_ground_truth(const io::Dataset& dataset, const Trajectory& estimate);

@@ -67,6 +67,7 @@ System::System(const StereoCalibration& calib, SystemOptions options, std::share
   tracker_ = std::make_unique<tracking::Tracker>(
       map_, options_.tracker, [mapper](map::KeyFrame* kf) { mapper->insert(kf); },
       [mapper, sequential] { return sequential || mapper->idle(); });
+  tracker_->set_mapping_queue([mapper, sequential] { return sequential ? std::size_t{0} : mapper->queued(); });
   tracker_->set_keyframe_database(database_.get());
   if (!sequential && !options_.localization_only) {
     mapper_->start();

@@ -18,6 +18,7 @@ void KeyframePolicyOptions::validate(const std::string& source) const {
   if (!(pid_output_limit >= 0 && pid_output_limit < 1)) fail("pid_output_limit", "must be in [0, 1)");
   if (!(max_speed > 0)) fail("max_speed", "must be positive");
   if (velocity_min_frames < 1) fail("velocity_min_frames", "must be >= 1");
+  if (max_queued < 1) fail("max_queued", "must be >= 1");
   if (!(kalman_options.accel_noise > 0)) fail("kalman_accel_noise", "must be positive");
   if (!(kalman_options.position_noise > 0)) fail("kalman_position_noise", "must be positive");
 }
@@ -82,6 +83,11 @@ KeyframeDecision KeyframePolicy::decide(const KeyframeInputs& in) {
              in.tracked_inliers > options_.min_inliers) {
     d.insert = true;
     d.reason = KeyframeReason::kVelocity;
+  }
+  if (d.insert && in.keyframes_queued >= options_.max_queued) {
+    d.insert = false;
+    d.reason = KeyframeReason::kNone;
+    d.queue_full = true;
   }
   return d;
 }

@@ -42,6 +42,11 @@ struct KeyframePolicyOptions {
   // time, and a keyframe on every frame would only repeat the same close points.
   int velocity_min_frames = 2;
   VelocityKalmanOptions kalman_options;
+  // Never more than this many keyframes waiting for local mapping: a keyframe due while the queue
+  // is full is not made (ORB-SLAM2's stereo rule, KeyframesInQueue() < 3). The keyframes the rules
+  // force regardless of mapping (max_frames, weak tracking, close points, velocity) would otherwise
+  // pile up when mapping cannot keep up, and queued keyframes skip fusion and local BA.
+  int max_queued = 3;
 
   // Throws InputError naming `source` and the offending option when out of range.
   void validate(const std::string& source = "keyframe options") const;
@@ -58,6 +63,7 @@ struct KeyframeInputs {
   int untracked_close = 0;          // close stereo points not yet in the map
   int keyframes_in_map = 0;
   bool local_mapping_idle = true;
+  int keyframes_queued = 0;         // keyframes waiting for local mapping
 };
 
 enum class KeyframeReason { kNone, kInlierRatio, kCloseDepth, kMaxFrames, kVelocity };
@@ -69,6 +75,7 @@ struct KeyframeDecision {
   double delta_pid = 0.0;  // the offset used this frame
   double threshold = 0.0;  // (KF_ref + Δ_PID) · ratio
   double speed = 0.0;      // Kalman speed estimate, m/s
+  bool queue_full = false; // a rule asked for a keyframe, but max_queued keyframes were waiting
 };
 
 class KeyframePolicy {

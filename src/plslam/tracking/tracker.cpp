@@ -171,6 +171,7 @@ bool Tracker::relocalize_and_track(Frame& f, TrackResult& result) {
 void Tracker::finish_tracked_frame(Frame& f, TrackResult& result) {
   const auto inputs = keyframe_inputs(f, result.point_inliers, result.line_inliers);
   result.decision = policy_.decide(inputs);
+  if (result.decision.queue_full) ++keyframes_refused_queue_full_;
   result.keyframe_inputs = inputs;
   result.local_keyframes = static_cast<int>(local_keyframes_.size());
   result.local_points = static_cast<int>(local_points_.size());
@@ -463,6 +464,7 @@ KeyframeInputs Tracker::keyframe_inputs(const Frame& f, int point_inliers, int l
   in.reference_tracked = reference_ ? reference_->tracked_map_points(min_obs) + reference_->tracked_map_lines(min_obs) : 0;
   in.keyframes_in_map = nkf;
   in.local_mapping_idle = mapping_idle_();
+  in.keyframes_queued = mapping_queue_ ? static_cast<int>(mapping_queue_()) : 0;
   const double th = close_depth(f);
   for (std::size_t i = 0; i < f.points.size(); ++i) {
     const float z = f.data->depth[i];

@@ -138,6 +138,10 @@ class Tracker {
   int lost_events() const { return lost_events_; }
   // Motion-model searches repeated in the wide windows (a low inlier share or few matches).
   int motion_wide_retries() const { return motion_wide_retries_; }
+  // Keyframes not made because local mapping's queue was full (KeyframePolicyOptions::max_queued).
+  int keyframes_refused_queue_full() const { return keyframes_refused_queue_full_; }
+  // How many keyframes wait for local mapping (KeyframeInputs::keyframes_queued); none when unset.
+  void set_mapping_queue(std::function<std::size_t()> queued) { mapping_queue_ = std::move(queued); }
   const std::vector<long>& relocalized_frames() const { return relocalized_frames_; }
   const std::vector<long>& new_segment_frames() const { return new_segment_frames_; }
   const std::vector<FrameRecord>& records() const { return records_; }
@@ -196,6 +200,8 @@ class Tracker {
   long seen_big_changes_ = 0;  // map_.big_changes() when the last frame was tracked
   int lost_events_ = 0;
   int motion_wide_retries_ = 0;
+  int keyframes_refused_queue_full_ = 0;
+  std::function<std::size_t()> mapping_queue_;
   const place::KeyframeDatabase* database_ = nullptr;
   std::optional<double> lost_since_;  // first textured frame that failed to relocalize
   std::vector<long> relocalized_frames_;
