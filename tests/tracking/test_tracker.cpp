@@ -161,6 +161,31 @@ TEST(Tracker, FewMotionMatchesForTheLastFramesPointsMeanASuddenTurnAndAWideSearc
   EXPECT_EQ(wide_retries_on_a_sudden_turn(0.0), 0);
 }
 
+// A pose far from the constant-velocity prediction is reported, never silently kept (issue 20):
+// here the camera really jumps 0.6 m sideways, so the pose is right and stays; a look-alike
+// place would look the same to this check. A 0.3 m jump is within the 0.5 m limit.
+std::vector<SuspectJump> jumps_after_a_sideways_jump(double metres) {
+  const auto world = scene();
+  Rig rig;
+  for (int k = 0; k <= 4; ++k) EXPECT_TRUE(rig.tracker.track(world.observe(walk(k), k).data).tracked);
+  EXPECT_EQ(rig.tracker.motion_deviation_m().size(), 3u);  // frames 2-4 had a velocity
+  for (double m : rig.tracker.motion_deviation_m()) EXPECT_LT(m, 1e-4);
+  const geometry::SE3 truth = geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-metres, 0, 0)) * walk(5);
+  EXPECT_TRUE(rig.tracker.track(world.observe(truth, 5).data).tracked);
+  EXPECT_LT(translation_error(rig.last_pose(), truth), 1e-4);
+  EXPECT_NEAR(rig.tracker.motion_deviation_m().back(), metres, 1e-3);
+  return rig.tracker.suspect_jumps();
+}
+
+TEST(Tracker, APoseFarFromThePredictionIsReportedAsASuspectJump) {
+  const auto jumps = jumps_after_a_sideways_jump(0.6);
+  ASSERT_EQ(jumps.size(), 1u);
+  EXPECT_EQ(jumps[0].frame_id, 5);
+  EXPECT_NEAR(jumps[0].deviation_m, 0.6, 1e-3);
+  EXPECT_LT(jumps[0].deviation_deg, 1e-3);
+  EXPECT_TRUE(jumps_after_a_sideways_jump(0.3).empty());
+}
+
 TEST(Tracker, ReportsLostWhenTheImageContentDisappears) {
   const auto world = scene();
   Rig rig;

@@ -144,6 +144,11 @@ std::vector<ConfigKey> make_table() {
           "in wider windows", in_closed(0, 1)),
     field("tracking", "motion_retry_scale", [](auto& o) -> auto& { return o.tracker.motion_retry_scale; },
           "how much wider those windows are", at_least(1)),
+    field("tracking", "jump_deviation_m", [](auto& o) -> auto& { return o.tracker.jump_deviation_m; },
+          "a tracked camera centre this far from the motion model's prediction is reported as a suspect jump "
+          "(0: no check)", at_least(0)),
+    field("tracking", "jump_deviation_deg", [](auto& o) -> auto& { return o.tracker.jump_deviation_deg; },
+          "the same for the rotation, degrees (0: no check)", at_least(0)),
     field("tracking", "min_local_inliers", [](auto& o) -> auto& { return o.tracker.min_local_inliers; },
           "point + line inliers of local map tracking for the frame to count as tracked"),
     field("tracking", "local_keyframes_max", [](auto& o) -> auto& { return o.tracker.local_keyframes_max; },

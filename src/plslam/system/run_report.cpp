@@ -102,6 +102,10 @@ nlohmann::json RunReport::to_json(const System& slam) const {
       ++before_init;
     }
   }
+  auto suspect_jumps = nlohmann::json::array();
+  for (const auto& j : slam.tracker().suspect_jumps()) {
+    suspect_jumps.push_back({{"frame", j.frame_id}, {"deviation_m", j.deviation_m}, {"deviation_deg", j.deviation_deg}});
+  }
   auto skipped_json = nlohmann::json::array();
   for (const auto& s : skipped) {
     skipped_json.push_back({{"frame", s.index}, {"timestamp", s.timestamp}, {"reason", s.reason}});
@@ -137,6 +141,9 @@ nlohmann::json RunReport::to_json(const System& slam) const {
           {"untracked_kitti_lines", untracked_lines},
           {"lost_events", slam.tracker().lost_events()},
           {"motion_wide_retries", slam.tracker().motion_wide_retries()},
+          {"motion_deviation",
+           {{"m", summarize(slam.tracker().motion_deviation_m())}, {"deg", summarize(slam.tracker().motion_deviation_deg())}}},
+          {"suspect_jumps", suspect_jumps},
           {"keyframes", slam.map().num_keyframes()},
           {"map_points", slam.map().num_points()},
           {"map_lines", slam.map().num_lines()},

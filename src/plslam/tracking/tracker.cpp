@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <unordered_set>
 
@@ -64,6 +65,21 @@ geometry::SE3 Tracker::pose_of(const FrameRecord& r) {
   return ref ? T_cr * ref->pose() : T_cr;
 }
 
+void Tracker::check_motion(const Frame& f) {
+  const geometry::SE3 predicted = predicted_pose(f);
+  const double m = (f.T_cw.inverse().translation() - predicted.inverse().translation()).norm();
+  const double deg = geometry::so3_log(f.T_cw.rotation() * predicted.rotation().transpose()).norm() * 180.0 / std::numbers::pi;
+  motion_deviation_m_.push_back(m);
+  motion_deviation_deg_.push_back(deg);
+  const bool far = options_.jump_deviation_m > 0 && m > options_.jump_deviation_m;
+  const bool turned = options_.jump_deviation_deg > 0 && deg > options_.jump_deviation_deg;
+  if (!far && !turned) return;
+  suspect_jumps_.push_back({f.id(), m, deg});
+  spdlog::warn("frame {}: suspect jump: the tracked pose is {:.2f} m and {:.1f} deg from the motion model's "
+               "prediction (limits {} m, {} deg)",
+               f.id(), m, deg, options_.jump_deviation_m, options_.jump_deviation_deg);
+}
+
 TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   Frame f(std::move(data));
   TrackResult result;
@@ -112,6 +128,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     }
     if (tracked) {
       ok = true;
+      if (velocity_) check_motion(f);
       velocity_ = (f.T_cw * last_->T_cw.inverse()).normalized();
       velocity_dt_ = f.data->timestamp - last_->data->timestamp;
       finish_tracked_frame(f, result);
