@@ -15,13 +15,19 @@ namespace live_capture_test {  // named: the unity build joins the test files
 using namespace std::chrono_literals;
 
 // Delivers `frames` frames (then ends), each after `period`, stamping frame i's pixels with i
-// so a test can tell which frame it got; throws after the last one when `fail` is set.
+// so a test can tell which frame it got; throws after the last one when `fail` is set. With a
+// `taken` counter, each frame (and the end) waits until the consumer has counted every frame
+// before it: a consumer that always keeps up, whatever the machine's load (a real-time "fast
+// consumer" test failed under ThreadSanitizer when the consumer thread slept past one period).
 class FakeSource final : public FrameSource {
  public:
-  FakeSource(std::size_t frames, std::chrono::microseconds period, bool fail = false)
-      : frames_(frames), period_(period), fail_(fail) {}
+  FakeSource(std::size_t frames, std::chrono::microseconds period, bool fail = false,
+             const std::atomic<std::size_t>* taken = nullptr)
+      : frames_(frames), period_(period), fail_(fail), taken_(taken) {}
 
   std::optional<CapturedFrame> capture() override {
+    // Bounded, so a broken consumer fails the test instead of hanging it.
+    for (int i = 0; taken_ && *taken_ < delivered_ && i < 100000; ++i) std::this_thread::sleep_for(100us);
     if (delivered_ == frames_) {
       if (fail_) throw InputError("/dev/fake", "no frame: the camera stopped delivering (unplugged?)");
       return std::nullopt;
@@ -42,24 +48,28 @@ class FakeSource final : public FrameSource {
   const std::size_t frames_;
   const std::chrono::microseconds period_;
   const bool fail_;
+  const std::atomic<std::size_t>* taken_;
   std::atomic<std::size_t> delivered_{0};
 };
 
-// Frames a consumer took until the source ended.
-std::vector<StereoFrame> take_all(LiveCapture& capture, std::chrono::milliseconds work) {
+// Frames a consumer took until the source ended (counted in `taken` when given).
+std::vector<StereoFrame> take_all(LiveCapture& capture, std::chrono::milliseconds work,
+                                  std::atomic<std::size_t>* taken = nullptr) {
   std::vector<StereoFrame> got;
   while (!capture.ended()) {
     auto f = capture.next(1000ms);
     if (!f) continue;
     got.push_back(std::move(*f));
+    if (taken) ++*taken;
     std::this_thread::sleep_for(work);  // "tracking"
   }
   return got;
 }
 
 TEST(LiveCapture, AFastConsumerGetsEveryFrameInOrder) {
-  LiveCapture capture(std::make_unique<FakeSource>(50, 2ms));
-  const auto got = take_all(capture, 0ms);
+  std::atomic<std::size_t> taken{0};
+  LiveCapture capture(std::make_unique<FakeSource>(50, 2ms, false, &taken));
+  const auto got = take_all(capture, 0ms, &taken);
   ASSERT_EQ(got.size(), 50u);
   for (std::size_t i = 0; i < got.size(); ++i) {
     EXPECT_EQ(got[i].index, i);
