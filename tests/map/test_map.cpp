@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "plslam/map/descriptor_utils.h"
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/map/map.h"
@@ -147,6 +149,60 @@ TEST(Map, PointWithOneObservationLeftBecomesBad) {
   p->erase_observation(b);
   EXPECT_TRUE(p->is_bad());
   EXPECT_EQ(a->map_point(0), nullptr);
+}
+
+TEST(Map, ABadLandmarkTakesNoObservation) {
+  Map map;
+  KeyFrame* a = map.create_keyframe(make_data(0, 10, 2), geometry::SE3());
+  MapPoint* p = map.create_point({0, 0, 1}, a, 0);
+  p->set_bad();
+  EXPECT_FALSE(p->add_observation(a, 0));
+  EXPECT_EQ(p->num_observations(), 0);
+  MapLine* l = map.create_line({0, 0, 1}, {1, 0, 1}, a, 0);
+  EXPECT_TRUE(l->add_observation(a, 0));
+}
+
+// Reclamation frees exactly the bad points and lines (ASan in CI checks the freeing), keeps the
+// good ones and every keyframe, calls the threads' clean-up first, and counts what it freed.
+TEST(Map, ReclaimFreesTheBadPointsAndLinesOnly) {
+  Fixture f;  // 55 good points
+  Map& map = f.map;
+  MapPoint* culled = map.points().front();
+  culled->set_bad();  // clears its keyframes' slots
+  MapPoint* replaced = map.points().front();
+  MapPoint* survivor = map.points().back();
+  replaced->replace_with(survivor);
+  MapLine* line = map.create_line({0, 0, 1}, {1, 0, 1}, f.k[0], 0);
+  MapLine* bad_line = map.create_line({0, 1, 1}, {1, 1, 1}, f.k[0], 0);
+  map.erase_line(bad_line);
+  const long survivor_id = survivor->id();
+  int calls = 0;
+  const auto freed = map.reclaim([&] {
+    ++calls;
+    EXPECT_TRUE(culled->is_bad());  // still alive while the threads drop their pointers
+  });
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(freed.points, 2);
+  EXPECT_EQ(freed.lines, 1);
+  EXPECT_EQ(map.num_points(), 53u);
+  EXPECT_EQ(map.num_lines(), 1u);
+  EXPECT_EQ(map.lines().front(), line);
+  EXPECT_EQ(map.num_keyframes(), 3u);
+  EXPECT_EQ(survivor->id(), survivor_id);
+  // No keyframe slot points at a freed object: every non-null slot is an active point.
+  const auto active = map.points();
+  const std::set<MapPoint*> alive(active.begin(), active.end());
+  for (auto* kf : f.k) {
+    for (auto* p : kf->map_points()) {
+      if (p) {
+        EXPECT_TRUE(alive.count(p));
+      }
+    }
+  }
+  const auto again = map.reclaim();
+  EXPECT_EQ(again.points, 0);
+  EXPECT_EQ(map.reclaimed().points, 2);
+  EXPECT_EQ(map.reclaimed().lines, 1);
 }
 
 // ORB-SLAM's observation count: stereo observations weigh 2, left-only ones 1, and the weight

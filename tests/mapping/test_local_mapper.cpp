@@ -100,5 +100,57 @@ TEST(LocalMapperSequential, ProcessPendingRunsTheFullBaWhateverWasRaisedBefore) 
   EXPECT_LT(r.error2(), 1e-4);
 }
 
+// Reclamation's seam: try_pause() holds an idle mapper only, and the held mapper takes no keyframe.
+TEST(LocalMapperThread, TryPauseHoldsOnlyAnIdleMapper) {
+  Row r;
+  LocalMapper mapper(r.m.map, no_culling());
+  mapper.start();
+  ASSERT_TRUE(mapper.try_pause());
+  mapper.insert(r.kf[3]);
+  EXPECT_EQ(mapper.queued(), 1u);
+  EXPECT_FALSE(mapper.try_pause());  // something waits: not idle
+  mapper.resume();
+  mapper.wait_idle();
+  EXPECT_EQ(mapper.queued(), 0u);
+  EXPECT_TRUE(mapper.try_pause());
+  mapper.resume();
+  mapper.stop();
+  EXPECT_EQ(mapper.stats().local_ba_ms.size(), 1u);
+}
+
+// Tracking associates a keyframe with the points it tracked; local mapping adds the observations
+// later. A point culled in between must leave the keyframe's slot, or it would outlive its
+// reclamation there.
+TEST(LocalMapperSequential, APointCulledBeforeItsKeyframeIsProcessedLeavesTheSlot) {
+  Row r;
+  int slot = -1;
+  map::MapPoint* q = nullptr;
+  const auto points = r.kf[3]->map_points();
+  for (std::size_t i = 0; i < points.size() && !q; ++i) {
+    if (points[i]) {
+      q = points[i];
+      slot = static_cast<int>(i);
+    }
+  }
+  ASSERT_NE(q, nullptr);
+  q->erase_observation(r.kf[3]);  // as tracking leaves it: in the slot, not observed
+  ASSERT_EQ(r.kf[3]->map_point(slot), q);
+  q->set_bad();  // culled by local mapping meanwhile
+  EXPECT_EQ(r.kf[3]->map_point(slot), q);
+  LocalMapper mapper(r.m.map, no_culling());
+  mapper.insert(r.kf[3]);
+  mapper.process_pending();
+  // Empty, or a point triangulated there since (the keypoint became free in both keyframes).
+  EXPECT_NE(r.kf[3]->map_point(slot), q);
+  EXPECT_EQ(r.m.map.reclaim([&] { mapper.drop_bad_landmarks(); }).points, 1);
+  for (auto* k : r.kf) {
+    for (auto* p : k->map_points()) {
+      if (p) {
+        EXPECT_FALSE(p->is_bad());
+      }
+    }
+  }
+}
+
 }  // namespace local_mapper_test
 }  // namespace plslam::mapping

@@ -46,6 +46,10 @@ TEST(RunConcurrent, SyntheticOfficeWithLocalMappingThread) {
   // scheduling (README), so this bound only catches a broken run, not a small regression.
   EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.10);
   expect_mapping_kept_up(stats);
+  // Culled points were freed while the threads ran (under ASan and TSan in CI: a pointer kept
+  // to a freed point would be caught there).
+  EXPECT_GT(stats["reclaimed"]["runs"].get<int>(), 0);
+  EXPECT_GT(stats["reclaimed"]["points"].get<int>(), 0);
 }
 
 // The first `frames` frames of a real excerpt: every one tracked, with at least `keyframes`.

@@ -80,6 +80,25 @@ void LoopCloser::insert(map::KeyFrame* kf) {
   cv_.notify_all();
 }
 
+bool LoopCloser::try_pause() {
+  std::lock_guard lock(queue_mutex_);
+  if (busy_ || !queue_.empty()) return false;
+  {
+    std::lock_guard gba_lock(gba_mutex_);
+    if (gba_running_) return false;
+  }
+  ++pauses_;
+  return true;
+}
+
+void LoopCloser::resume() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    --pauses_;
+  }
+  cv_.notify_all();
+}
+
 void LoopCloser::process_pending() {
   std::unique_lock lock(queue_mutex_);
   while (!queue_.empty()) {
@@ -162,8 +181,12 @@ void LoopCloser::run() {
   core::lower_this_thread_priority(kBackgroundNice);
   std::unique_lock lock(queue_mutex_);
   for (;;) {
-    cv_.wait(lock, [this] { return !queue_.empty() || stop_requested_; });
+    cv_.wait(lock, [this] { return (!queue_.empty() && pauses_ == 0) || stop_requested_; });
     if (queue_.empty()) break;
+    if (pauses_ > 0) {
+      cv_.wait(lock, [this] { return pauses_ == 0; });
+      continue;
+    }
     map::KeyFrame* kf = queue_.front();
     queue_.pop_front();
     busy_ = true;

@@ -85,6 +85,10 @@ class LoopCloser {
   // wait_idle(), then waits up to options.finish_wait_s for a running global BA (aborting it after
   // that, with a warning); returns false if it had to abort.
   bool finish();
+  // Holds loop closing only if idle: nothing queued or in progress, no global BA running; true if
+  // it did (resume() after). For Map::reclaim(), which needs every thread at rest.
+  bool try_pause();
+  void resume();
   LoopClosingStats stats() const;
 
  private:
@@ -110,6 +114,7 @@ class LoopCloser {
   std::deque<map::KeyFrame*> queue_;
   bool busy_ = false;
   bool stop_requested_ = false;
+  int pauses_ = 0;
   std::thread thread_;
 
   std::thread gba_thread_;

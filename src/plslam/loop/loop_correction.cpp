@@ -109,9 +109,10 @@ LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, con
         there->replace_with(p);
         ++r.fused_points;
       } else {
-        p->add_observation(kf, j);
-        kf->add_map_point(p, j);
-        ++r.added_points;
+        if (p->add_observation(kf, j)) {
+          kf->add_map_point(p, j);
+          ++r.added_points;
+        }
       }
     }
     for (MapLine* l : place_lines) {
@@ -123,9 +124,10 @@ LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, con
         there->replace_with(l);
         ++r.fused_lines;
       } else {
-        l->add_observation(kf, j);
-        kf->add_map_line(l, j);
-        ++r.added_lines;
+        if (l->add_observation(kf, j)) {
+          kf->add_map_line(l, j);
+          ++r.added_lines;
+        }
       }
     }
   }

@@ -9,6 +9,7 @@
 // Owned by the Map; the state is guarded by the landmark's own mutex because tracking reads it
 // while local mapping writes it. Member definitions: landmark_impl.h, instantiated by the derived
 // classes' .cpp files.
+#include <atomic>
 #include <map>
 
 #include "plslam/map/by_id.h"
@@ -39,8 +40,10 @@ class Landmark {
   long id() const { return id_; }
   long created_frame() const { return created_frame_; }
 
-  // Observations: keyframe -> index of the feature in that keyframe.
-  void add_observation(KeyFrame* kf, int index);
+  // Observations: keyframe -> index of the feature in that keyframe. A bad landmark takes none
+  // (returns false): the caller must not leave it in the keyframe's slot, where it would outlive
+  // reclamation (Map::reclaim).
+  bool add_observation(KeyFrame* kf, int index);
   // Removes one; a landmark left with fewer than two observing keyframes turns bad.
   void erase_observation(KeyFrame* kf);
   IdMap<KeyFrame, int> observations() const;
@@ -92,7 +95,9 @@ class Landmark {
   KeyFrame* reference_;
   double min_distance_ = 0, max_distance_ = 0;
   int visible_ = 1, found_ = 1;
-  bool bad_ = false;
+  // Written under mutex_; read without it by is_bad(), which tracking and reclamation call for
+  // every landmark they touch.
+  std::atomic<bool> bad_{false};
   Derived* replaced_by_ = nullptr;
 };
 

@@ -9,15 +9,17 @@
 namespace plslam::map {
 
 template <class D>
-void Landmark<D>::add_observation(KeyFrame* kf, int index) {
+bool Landmark<D>::add_observation(KeyFrame* kf, int index) {
   const int weight = D::is_stereo(*kf, index) ? 2 : 1;
   std::lock_guard lock(mutex_);
+  if (bad_) return false;
   const auto [it, inserted] = observations_.try_emplace(kf, index);
   if (!inserted) {
     observation_weight_ -= D::is_stereo(*kf, it->second) ? 2 : 1;
     it->second = index;
   }
   observation_weight_ += weight;
+  return true;
 }
 
 template <class D>
@@ -133,8 +135,7 @@ double Landmark<D>::found_ratio() const {
 
 template <class D>
 bool Landmark<D>::is_bad() const {
-  std::lock_guard lock(mutex_);
-  return bad_;
+  return bad_.load(std::memory_order_acquire);
 }
 
 template <class D>
@@ -142,8 +143,8 @@ void Landmark<D>::set_bad() {
   IdMap<KeyFrame, int> obs;
   {
     std::lock_guard lock(mutex_);
-    if (bad_) return;
-    bad_ = true;
+    if (bad_.load(std::memory_order_relaxed)) return;
+    bad_.store(true, std::memory_order_release);
     obs.swap(observations_);
     observation_weight_ = 0;
   }
@@ -161,8 +162,8 @@ void Landmark<D>::replace_with(D* other) {
   int visible = 0, found = 0;
   {
     std::lock_guard lock(mutex_);
-    if (bad_) return;
-    bad_ = true;
+    if (bad_.load(std::memory_order_relaxed)) return;
+    bad_.store(true, std::memory_order_release);
     obs.swap(observations_);
     observation_weight_ = 0;
     visible = visible_;

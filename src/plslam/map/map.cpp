@@ -18,18 +18,22 @@ KeyFrame* Map::create_keyframe(std::shared_ptr<const FrameData> data, const geom
 MapPoint* Map::create_point(const Eigen::Vector3d& position, KeyFrame* reference, long frame_id) {
   std::lock_guard lock(mutex_);
   ++changes_;
-  all_points_.push_back(std::make_unique<MapPoint>(next_point_id_++, position, reference, frame_id));
-  points_.insert(all_points_.back().get());
-  return all_points_.back().get();
+  auto p = std::make_unique<MapPoint>(next_point_id_++, position, reference, frame_id);
+  MapPoint* raw = p.get();
+  all_points_.emplace(raw, std::move(p));
+  points_.insert(raw);
+  return raw;
 }
 
 MapLine* Map::create_line(const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
                           long frame_id) {
   std::lock_guard lock(mutex_);
   ++changes_;
-  all_lines_.push_back(std::make_unique<MapLine>(next_line_id_++, start, end, reference, frame_id));
-  lines_.insert(all_lines_.back().get());
-  return all_lines_.back().get();
+  auto l = std::make_unique<MapLine>(next_line_id_++, start, end, reference, frame_id);
+  MapLine* raw = l.get();
+  all_lines_.emplace(raw, std::move(l));
+  lines_.insert(raw);
+  return raw;
 }
 
 KeyFrame* Map::restore_keyframe(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw) {
@@ -51,13 +55,12 @@ MapPoint* Map::restore_point(long id, const Eigen::Vector3d& position, KeyFrame*
   std::lock_guard lock(mutex_);
   ++changes_;
   if (id < 0) throw std::invalid_argument("negative point id");
-  all_points_.push_back(std::make_unique<MapPoint>(id, position, reference, frame_id));
-  if (!points_.insert(all_points_.back().get()).second) {
-    all_points_.pop_back();
-    throw std::invalid_argument("duplicate point id " + std::to_string(id));
-  }
+  auto p = std::make_unique<MapPoint>(id, position, reference, frame_id);
+  MapPoint* raw = p.get();
+  if (!points_.insert(raw).second) throw std::invalid_argument("duplicate point id " + std::to_string(id));
+  all_points_.emplace(raw, std::move(p));
   next_point_id_ = std::max(next_point_id_, id + 1);
-  return all_points_.back().get();
+  return raw;
 }
 
 MapLine* Map::restore_line(long id, const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
@@ -65,13 +68,12 @@ MapLine* Map::restore_line(long id, const Eigen::Vector3d& start, const Eigen::V
   std::lock_guard lock(mutex_);
   ++changes_;
   if (id < 0) throw std::invalid_argument("negative line id");
-  all_lines_.push_back(std::make_unique<MapLine>(id, start, end, reference, frame_id));
-  if (!lines_.insert(all_lines_.back().get()).second) {
-    all_lines_.pop_back();
-    throw std::invalid_argument("duplicate line id " + std::to_string(id));
-  }
+  auto l = std::make_unique<MapLine>(id, start, end, reference, frame_id);
+  MapLine* raw = l.get();
+  if (!lines_.insert(raw).second) throw std::invalid_argument("duplicate line id " + std::to_string(id));
+  all_lines_.emplace(raw, std::move(l));
   next_line_id_ = std::max(next_line_id_, id + 1);
-  return all_lines_.back().get();
+  return raw;
 }
 
 Map::NextIds Map::next_ids() const {
@@ -93,15 +95,54 @@ void Map::erase_keyframe(KeyFrame* kf) {
 }
 
 void Map::erase_point(MapPoint* p) {
+  p->set_bad();
   std::lock_guard lock(mutex_);
   ++changes_;
   points_.erase(p);
 }
 
 void Map::erase_line(MapLine* l) {
+  l->set_bad();
   std::lock_guard lock(mutex_);
   ++changes_;
   lines_.erase(l);
+}
+
+namespace {
+
+// Frees the bad objects of `all` (and drops them from the active set); returns how many.
+template <class Object>
+int free_bad(std::unordered_map<const Object*, std::unique_ptr<Object>>& all, IdSet<Object>& active_set) {
+  int freed = 0;
+  for (auto it = all.begin(); it != all.end();) {
+    if (it->second->is_bad()) {
+      active_set.erase(it->second.get());
+      it = all.erase(it);
+      ++freed;
+    } else {
+      ++it;
+    }
+  }
+  return freed;
+}
+
+}  // namespace
+
+Map::Reclaimed Map::reclaim(const std::function<void()>& drop_bad) {
+  std::unique_lock hold(objects_mutex_);
+  if (drop_bad) drop_bad();
+  std::lock_guard lock(mutex_);
+  Reclaimed r;
+  r.points = free_bad(all_points_, points_);
+  r.lines = free_bad(all_lines_, lines_);
+  reclaimed_.points += r.points;
+  reclaimed_.lines += r.lines;
+  return r;
+}
+
+Map::Reclaimed Map::reclaimed() const {
+  std::lock_guard lock(mutex_);
+  return reclaimed_;
 }
 
 namespace {
@@ -142,6 +183,11 @@ std::vector<MapLine*> Map::lines() const {
 std::size_t Map::num_keyframes() const { return keyframes().size(); }
 std::size_t Map::num_points() const { return points().size(); }
 std::size_t Map::num_lines() const { return lines().size(); }
+
+Map::Sizes Map::sizes() const {
+  std::lock_guard lock(mutex_);
+  return {keyframes_.size(), points_.size(), lines_.size()};
+}
 
 KeyFrame* Map::first_keyframe() const {
   std::lock_guard lock(mutex_);

@@ -1,11 +1,17 @@
 #pragma once
-// The map: owner of every keyframe, map point and map line. Objects are never freed before the
-// Map itself, so the raw pointers that frames, keyframes and landmarks keep to each other stay
-// valid; culled objects are flagged bad and leave the active sets. Thread-safe.
+// The map: owner of every keyframe, map point and map line. Culled objects are flagged bad and
+// leave the active sets. Keyframes live as long as the Map (a culled keyframe still anchors the
+// poses of the frames tracked against it). Culled points and lines are freed by reclaim(), which
+// the caller runs only at a point where no thread can hold a pointer to them (see reclaim()).
+// Thread-safe.
 #include <atomic>
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <set>
+#include <shared_mutex>
+#include <unordered_map>
 #include <vector>
 
 #include "plslam/map/keyframe.h"
@@ -38,10 +44,26 @@ class Map {
   NextIds next_ids() const;
   void restore_next_ids(const NextIds& next);
 
-  // Removes from the active sets (the object stays alive until the Map is destroyed).
+  // Removes from the active set (a keyframe stays alive until the Map is destroyed).
   void erase_keyframe(KeyFrame* kf);
+  // Culls (set_bad()) and removes from the active set; reclaim() frees it later.
   void erase_point(MapPoint* p);
   void erase_line(MapLine* l);
+
+  // Frees every bad point and line. Call it only where no thread can hold a pointer to a bad
+  // one: tracking at a frame boundary, local mapping and loop closing idle and held paused, no
+  // global BA running (System::reclaim_culled). Set_bad() has cleared the keyframes' slots, so
+  // the only pointers left are those the threads keep across steps (the tracker's last frame,
+  // local mapping's probation list): `drop_bad` runs first, under the same lock, and must clear
+  // them. Snapshot readers in other threads hold hold_objects() while they read.
+  struct Reclaimed {
+    int points = 0, lines = 0;
+  };
+  Reclaimed reclaim(const std::function<void()>& drop_bad = {});
+  // While held, reclaim() waits: for readers outside the SLAM threads (snapshots, map writers).
+  std::shared_lock<std::shared_mutex> hold_objects() const { return std::shared_lock(objects_mutex_); }
+  // Totals freed so far.
+  Reclaimed reclaimed() const;
 
   std::vector<KeyFrame*> keyframes() const;  // active, by id
   std::vector<MapPoint*> points() const;
@@ -49,6 +71,12 @@ class Map {
   std::size_t num_keyframes() const;
   std::size_t num_points() const;
   std::size_t num_lines() const;
+  // The active sets' sizes without filtering them: objects turned bad since the last access or
+  // reclaim() are still counted. For logs (frames.csv), where num_points()'s O(n) copy is waste.
+  struct Sizes {
+    std::size_t keyframes = 0, points = 0, lines = 0;
+  };
+  Sizes sizes() const;
   // The first keyframe created or restored: the origin (KeyFrame::is_origin()), whatever its id.
   KeyFrame* first_keyframe() const;
 
@@ -73,11 +101,14 @@ class Map {
  private:
   mutable std::mutex mutex_;
   mutable std::mutex update_mutex_;
+  mutable std::shared_mutex objects_mutex_;  // exclusive in reclaim()
   std::atomic<long> big_changes_{0};
   std::atomic<long> changes_{0};
   std::vector<std::unique_ptr<KeyFrame>> all_keyframes_;
-  std::vector<std::unique_ptr<MapPoint>> all_points_;
-  std::vector<std::unique_ptr<MapLine>> all_lines_;
+  // Points and lines until freed by reclaim(); keyed by address to free one in O(1).
+  std::unordered_map<const MapPoint*, std::unique_ptr<MapPoint>> all_points_;
+  std::unordered_map<const MapLine*, std::unique_ptr<MapLine>> all_lines_;
+  Reclaimed reclaimed_;  // guarded by mutex_
   mutable IdSet<KeyFrame> keyframes_;
   mutable IdSet<MapPoint> points_;
   mutable IdSet<MapLine> lines_;

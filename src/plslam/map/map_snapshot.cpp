@@ -5,6 +5,7 @@
 namespace plslam::map {
 
 MapSnapshot take_snapshot(const Map& map) {
+  const auto hold = map.hold_objects();  // nothing is freed while the points are read
   std::lock_guard lock(map.update_mutex());
   MapSnapshot s;
   s.changes = map.changes();

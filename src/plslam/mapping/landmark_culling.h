@@ -41,6 +41,12 @@ class RecentLandmarks {
   // the bad ones and those past probation.
   Culled cull(long current_id);
 
+  // Forgets the bad ones only (before Map::reclaim() frees them).
+  void drop_bad() {
+    std::erase_if(points_, [](const auto& e) { return e.first->is_bad(); });
+    std::erase_if(lines_, [](const auto& e) { return e.first->is_bad(); });
+  }
+
   std::size_t points_on_probation() const { return points_.size(); }
   std::size_t lines_on_probation() const { return lines_.size(); }
 

@@ -24,8 +24,7 @@ int fuse_landmarks(map::KeyFrame& kf, const FusionOptions& o) {
         }
         ++fused;
       } else {
-        mp->add_observation(kf2, best_j);
-        kf2->add_map_point(mp, best_j);
+        if (mp->add_observation(kf2, best_j)) kf2->add_map_point(mp, best_j);
       }
     }
   }

@@ -81,6 +81,13 @@ bool LocalMapper::idle() const {
   return queue_.empty() && !busy_;
 }
 
+bool LocalMapper::try_pause() {
+  std::lock_guard lock(queue_mutex_);
+  if (busy_ || !queue_.empty()) return false;
+  ++pauses_;
+  return true;
+}
+
 std::size_t LocalMapper::queued() const {
   std::lock_guard lock(queue_mutex_);
   return queue_.size();
@@ -163,9 +170,18 @@ void LocalMapper::process_new_keyframe(map::KeyFrame* kf) {
   const auto points = kf->map_points();
   for (std::size_t i = 0; i < points.size(); ++i) {
     map::MapPoint* mp = points[i];
-    if (!mp || mp->is_bad()) continue;
+    if (!mp) continue;
+    // Culled since tracking associated it: a bad point must not stay in the slot, where it would
+    // outlive reclamation (Map::reclaim).
+    if (mp->is_bad()) {
+      kf->erase_map_point(static_cast<int>(i));
+      continue;
+    }
     if (mp->index_in(kf) < 0) {
-      mp->add_observation(kf, static_cast<int>(i));
+      if (!mp->add_observation(kf, static_cast<int>(i))) {
+        kf->erase_map_point(static_cast<int>(i));
+        continue;
+      }
       mp->update_normal_and_depth();
       mp->update_descriptor();
     } else {
@@ -175,9 +191,16 @@ void LocalMapper::process_new_keyframe(map::KeyFrame* kf) {
   const auto lines = kf->map_lines();
   for (std::size_t j = 0; j < lines.size(); ++j) {
     map::MapLine* ml = lines[j];
-    if (!ml || ml->is_bad()) continue;
+    if (!ml) continue;
+    if (ml->is_bad()) {
+      kf->erase_map_line(static_cast<int>(j));
+      continue;
+    }
     if (ml->index_in(kf) < 0) {
-      ml->add_observation(kf, static_cast<int>(j));
+      if (!ml->add_observation(kf, static_cast<int>(j))) {
+        kf->erase_map_line(static_cast<int>(j));
+        continue;
+      }
       ml->update_normal_and_depth();
       ml->update_descriptor();
     } else {

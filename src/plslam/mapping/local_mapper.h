@@ -92,6 +92,11 @@ class LocalMapper {
   // is cleared when the next keyframe starts.
   void abort_ba();
   bool idle() const;
+  // Pauses only if idle (nothing queued, nothing in progress); true if it did (resume() after).
+  bool try_pause();
+  // Forgets the culled landmarks it keeps between keyframes (before Map::reclaim()); call while
+  // paused with try_pause(), or from the thread that calls process_pending().
+  void drop_bad_landmarks() { recent_.drop_bad(); }
   std::size_t queued() const;
   // Processes every queued keyframe in the calling thread (deterministic mode and tests).
   void process_pending();

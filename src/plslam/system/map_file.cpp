@@ -503,6 +503,7 @@ void check_references(const MapContents& c, const std::string& source) {
 }  // namespace
 
 MapContents capture_map(const map::Map& map, const place::KeyframeDatabase* database, MapFileMeta meta) {
+  const auto hold = map.hold_objects();  // nothing is freed while the map is read
   MapContents c;
   c.meta = std::move(meta);
   c.meta.version = kMapFileVersion;

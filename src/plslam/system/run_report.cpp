@@ -49,7 +49,7 @@ nlohmann::json global_ba_ms(const System& slam) {
 const char* RunReport::frames_csv_header() {
   return "frame,timestamp,state,tracked,keyframe,keyframe_reason,point_inliers,line_inliers,reference_tracked,"
          "keyframe_threshold,delta_pid,speed_mps,tracked_close,untracked_close,local_keyframes,local_points,"
-         "local_lines,stereo_points,stereo_lines,tracking_ms";
+         "local_lines,stereo_points,stereo_lines,tracking_ms,map_keyframes,map_points,map_lines,rss_mb";
 }
 
 void RunReport::write_frames_csv(std::ostream& out) const {
@@ -61,12 +61,12 @@ void RunReport::add(const FrameResult& r) {
   const auto& in = r.track.keyframe_inputs;
   const auto& d = r.track.decision;
   frame_rows.push_back(fmt::format(
-      "{},{:.9f},{},{},{},{},{},{},{},{:.2f},{:.2f},{:.3f},{},{},{},{},{},{},{},{:.3f}", r.frame_id, r.timestamp,
+      "{},{:.9f},{},{},{},{},{},{},{},{:.2f},{:.2f},{:.3f},{},{},{},{},{},{},{},{:.3f},{},{},{},{:.1f}", r.frame_id, r.timestamp,
       tracking::to_string(r.track.state), r.track.tracked ? 1 : 0, r.track.keyframe ? 1 : 0,
       r.track.keyframe ? (r.track.decision.insert ? tracking::to_string(d.reason) : "new-map") : "", r.track.point_inliers, r.track.line_inliers,
       in.reference_tracked, d.threshold, d.delta_pid, d.speed, in.tracked_close, in.untracked_close,
       r.track.local_keyframes, r.track.local_points, r.track.local_lines, r.extraction.stereo_points,
-      r.extraction.stereo_lines, r.tracking_ms));
+      r.extraction.stereo_lines, r.tracking_ms, r.map_size.keyframes, r.map_size.points, r.map_size.lines, r.rss_mb));
   ++frames;
   if (r.track.tracked) ++tracked_frames;
   tracking_ms.push_back(r.tracking_ms);
@@ -147,6 +147,11 @@ nlohmann::json RunReport::to_json(const System& slam) const {
           {"keyframes", slam.map().num_keyframes()},
           {"map_points", slam.map().num_points()},
           {"map_lines", slam.map().num_lines()},
+          {"reclaimed",
+           {{"runs", slam.reclaim_stats().runs},
+            {"points", slam.reclaim_stats().points},
+            {"lines", slam.reclaim_stats().lines},
+            {"ms", summarize(slam.reclaim_stats().ms)}}},
           {"tracking_ms", summarize(tracking_ms)},
           {"stages_ms",
            {{"extraction", percentile(extraction_ms, 0.5)},

@@ -1,5 +1,6 @@
 #include "plslam/system/slam_system.h"
 
+#include "plslam/core/resident_memory.h"
 #include "plslam/core/stopwatch.h"
 
 #include <algorithm>
@@ -91,7 +92,30 @@ FrameResult System::process(const io::StereoFrame& frame) {
     mapper_->process_pending();
     if (loop_closer_) loop_closer_->process_pending();
   }
+  reclaim_culled();
+  r.map_size = map_.sizes();
+  r.rss_mb = core::resident_memory_mb();
   return r;
+}
+
+void System::reclaim_culled() {
+  const long next_keyframe = map_.next_ids().keyframe;
+  if (next_keyframe == reclaimed_at_keyframe_) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!mapper_->try_pause()) return;
+  if (!loop_closer_ || loop_closer_->try_pause()) {
+    const auto freed = map_.reclaim([this] {
+      tracker_->drop_bad_landmarks();
+      mapper_->drop_bad_landmarks();
+    });
+    if (loop_closer_) loop_closer_->resume();
+    reclaimed_at_keyframe_ = next_keyframe;
+    ++reclaim_stats_.runs;
+    reclaim_stats_.points += freed.points;
+    reclaim_stats_.lines += freed.lines;
+    reclaim_stats_.ms.push_back(ms_since(t0));
+  }
+  mapper_->resume();
 }
 
 void System::finish() {

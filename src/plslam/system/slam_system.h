@@ -50,6 +50,10 @@ struct FrameResult {
   tracking::TrackResult track;
   tracking::FrameTimings extraction;
   double tracking_ms = 0;  // images in to pose out
+  // After the frame (and any reclamation it triggered): the map's size and the process's
+  // resident memory (-1 where unknown), to see memory and map growth over long runs.
+  map::Map::Sizes map_size;
+  double rss_mb = -1;
 };
 
 class System {
@@ -86,8 +90,19 @@ class System {
   mapping::LocalMapperStats mapper_stats() const { return mapper_->stats(); }
   // Null without loop closing.
   const loop::LoopCloser* loop_closer() const { return loop_closer_.get(); }
+  // Culled points and lines freed so far (Map::reclaim), and the time it took in tracking's thread.
+  struct ReclaimStats {
+    int runs = 0, points = 0, lines = 0;
+    std::vector<double> ms;
+  };
+  const ReclaimStats& reclaim_stats() const { return reclaim_stats_; }
 
  private:
+  // Frees the culled points and lines when every thread is at rest: tracking between frames,
+  // local mapping and loop closing idle (held paused meanwhile), no global BA. At most once per
+  // new keyframe; when a thread is busy, a later frame does it.
+  void reclaim_culled();
+
   SystemOptions options_;
   map::Map map_;
   tracking::FrameExtractor extractor_;
@@ -97,6 +112,8 @@ class System {
   std::unique_ptr<tracking::Tracker> tracker_;
   StereoCalibration calib_;
   bool finished_ = false;
+  long reclaimed_at_keyframe_ = 0;  // map_.next_ids().keyframe at the last reclamation
+  ReclaimStats reclaim_stats_;
 };
 
 }  // namespace plslam::system

@@ -495,6 +495,19 @@ KeyframeInputs Tracker::keyframe_inputs(const Frame& f, int point_inliers, int l
   return in;
 }
 
+void Tracker::drop_bad_landmarks() {
+  if (last_) {
+    for (auto& p : last_->points) {
+      if (p && p->is_bad()) p = nullptr;
+    }
+    for (auto& l : last_->lines) {
+      if (l && l->is_bad()) l = nullptr;
+    }
+  }
+  std::erase_if(local_points_, [](const map::MapPoint* p) { return p->is_bad(); });
+  std::erase_if(local_lines_, [](const map::MapLine* l) { return l->is_bad(); });
+}
+
 void Tracker::create_stereo_point(Frame& f, map::KeyFrame* kf, std::size_t i) {
   const auto& d = *f.data;
   const geometry::StereoCamera cam(d.calib);

@@ -163,6 +163,9 @@ class Tracker {
   int keyframes_refused_queue_full() const { return keyframes_refused_queue_full_; }
   // How many keyframes wait for local mapping (KeyframeInputs::keyframes_queued); none when unset.
   void set_mapping_queue(std::function<std::size_t()> queued) { mapping_queue_ = std::move(queued); }
+  // Forgets the culled points and lines it keeps between frames (the last frame's matches, the
+  // local map), so that Map::reclaim() can free them; call between frames.
+  void drop_bad_landmarks();
   const std::vector<long>& relocalized_frames() const { return relocalized_frames_; }
   const std::vector<long>& new_segment_frames() const { return new_segment_frames_; }
   const std::vector<FrameRecord>& records() const { return records_; }
