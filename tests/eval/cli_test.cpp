@@ -75,13 +75,17 @@ TEST(EvalCli, JsonHasExactlyTheDocumentedKeys) {
   EXPECT_NE(r.err.find("matched 300 pose pairs"), std::string::npos) << r.err;
 }
 
+// frames.csv's columns up to tracking_ms.
+constexpr const char* kFrameLogColumns =
+    "frame,timestamp,state,tracked,keyframe,keyframe_reason,point_inliers,line_inliers,reference_tracked,"
+    "keyframe_threshold,delta_pid,speed_mps,tracked_close,untracked_close,local_keyframes,local_points,"
+    "local_lines,stereo_points,stereo_lines,tracking_ms";
+
 // tracking.png from a run's frames.csv: drawn with the keyframes; a broken log is refused.
 TEST(EvalCli, PlotsTheFrameLogNextToTheError) {
   Files f;
   const Trajectory g = test::helix(300);
-  std::string csv = "frame,timestamp,state,tracked,keyframe,keyframe_reason,point_inliers,line_inliers,reference_tracked,"
-                    "keyframe_threshold,delta_pid,speed_mps,tracked_close,untracked_close,local_keyframes,local_points,"
-                    "local_lines,stereo_points,stereo_lines,tracking_ms\n";
+  std::string csv = std::string(kFrameLogColumns) + "\n";  // as runs wrote it before the map_* and rss_mb columns
   for (std::size_t i = 0; i < g.size(); ++i) {
     const bool kf = i % 10 == 0;
     csv += fmt::format("{},{:.9f},OK,1,{},{},{},{},400,{},0,1.0,150,200,5,2000,100,800,120,20.0\n", i, g[i].t, kf ? 1 : 0,
@@ -98,6 +102,7 @@ TEST(EvalCli, PlotsTheFrameLogNextToTheError) {
   cv::Mat red;  // keyframe markers are red (BGR 40, 39, 214)
   cv::inRange(img, cv::Scalar(30, 29, 200), cv::Scalar(50, 49, 230), red);
   EXPECT_GT(cv::countNonZero(red), 300);
+  EXPECT_FALSE(std::filesystem::exists(dir / "resources.png"));  // no map_* / rss_mb columns: no resources plot
 
   write_text(frames, "frame,timestamp,keyframe\n0,1.0\n");
   const auto bad = run_cli("eval --gt " + q(f.gt) + " --est " + q(f.est) + " --plot " + q(dir) + " --frames " + q(frames));
@@ -107,6 +112,32 @@ TEST(EvalCli, PlotsTheFrameLogNextToTheError) {
   EXPECT_NE(run_cli("eval --gt " + q(f.gt) + " --est " + q(f.est) + " --plot " + q(dir) + " --frames " + q(frames)).err.find("no 'frame' column"),
             std::string::npos);
   EXPECT_EQ(run_cli("eval --gt " + q(f.gt) + " --est " + q(f.est) + " --frames " + q(frames)).exit_code, 2);  // needs --plot
+}
+
+// resources.png from a long run's frames.csv (map_* and rss_mb columns): the memory curve is drawn
+// in the middle panel.
+TEST(EvalCli, PlotsMemoryTimeAndMapSizeOfALongRun) {
+  Files f;
+  const Trajectory g = test::helix(300);
+  std::string csv = std::string(kFrameLogColumns) + ",map_keyframes,map_points,map_lines,rss_mb\n";
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const double grow = static_cast<double>(std::min<std::size_t>(i, 150));
+    csv += fmt::format("{},{:.9f},OK,1,0,,300,40,400,200,0,1.0,150,200,5,2000,100,800,120,{:.1f},{},{},{},{:.1f}\n", i,
+                       g[i].t, 20.0 + static_cast<double>(i % 7), 1 + i / 10, 1000 + 10 * grow, 100 + grow, 200 + grow);
+  }
+  const auto frames = f.dir.path() / "frames.csv";
+  write_text(frames, csv);
+  const auto dir = plslam::test::artifacts_dir() / "eval_cli_resources";
+  std::filesystem::remove_all(dir);
+  const auto r = run_cli("eval --gt " + q(f.gt) + " --est " + q(f.est) + " --plot " + q(dir) + " --frames " + q(frames));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("resources.png"), std::string::npos) << r.err;
+  const cv::Mat img = cv::imread((dir / "resources.png").string());
+  ASSERT_FALSE(img.empty());
+  EXPECT_EQ(img.rows, 1200);
+  cv::Mat red;  // the resident memory is drawn red (BGR 40, 39, 214) in the middle panel
+  cv::inRange(img(cv::Rect(0, 400, img.cols, 400)), cv::Scalar(30, 29, 200), cv::Scalar(50, 49, 230), red);
+  EXPECT_GT(cv::countNonZero(red), 500);
 }
 
 TEST(EvalCli, HumanReadableByDefault) {

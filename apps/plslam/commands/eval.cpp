@@ -105,8 +105,12 @@ int run(const Options& o) {
       spdlog::info("wrote {}", p.string());
     }
     if (!o.frames.empty()) {
-      const auto p = plslam::eval::write_tracking_plot(result, plslam::eval::read_frame_log(o.frames), o.plot_dir, plot_options);
+      const auto log = plslam::eval::read_frame_log(o.frames);
+      const auto p = plslam::eval::write_tracking_plot(result, log, o.plot_dir, plot_options);
       spdlog::info("wrote {}", p.string());
+      if (plslam::eval::has_resource_columns(log)) {
+        spdlog::info("wrote {}", plslam::eval::write_resources_plot(log, o.plot_dir).string());
+      }
     }
   }
   if (o.json) {

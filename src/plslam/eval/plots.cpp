@@ -218,4 +218,84 @@ std::filesystem::path write_tracking_plot(const EvalResult& r, const FrameLog& l
   return path;
 }
 
+bool has_resource_columns(const FrameLog& log) {
+  for (const char* c : {"map_keyframes", "map_points", "map_lines", "rss_mb", "tracking_ms"}) {
+    if (std::find(log.header.begin(), log.header.end(), c) == log.header.end()) return false;
+  }
+  return true;
+}
+
+namespace {
+
+std::vector<double> running_median(const std::vector<double>& v, int window) {
+  std::vector<double> out(v.size());
+  const std::size_t half = static_cast<std::size_t>(std::max(window, 1) / 2);
+  std::vector<double> w;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::size_t lo = i >= half ? i - half : 0;
+    const std::size_t hi = std::min(v.size(), i + half + 1);
+    w.assign(v.begin() + static_cast<std::ptrdiff_t>(lo), v.begin() + static_cast<std::ptrdiff_t>(hi));
+    std::nth_element(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(w.size() / 2), w.end());
+    out[i] = w[w.size() / 2];
+  }
+  return out;
+}
+
+}  // namespace
+
+std::filesystem::path write_resources_plot(const FrameLog& log, const std::filesystem::path& dir, int window) {
+  if (!has_resource_columns(log)) {
+    throw InputError(log.source, "no map_keyframes, map_points, map_lines and rss_mb columns (a frames.csv of an older run)");
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError(dir.string(), "cannot create the plot folder: " + ec.message());
+  const auto frame = log.numbers("frame");
+  auto series = [&](const std::vector<double>& v, double scale = 1.0) {
+    std::vector<cv::Point2d> pts;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (v[i] >= 0) pts.emplace_back(frame[i], v[i] * scale);
+    }
+    return pts;
+  };
+  cv::Mat img(1200, 1100, CV_8UC3);
+  const int h = img.rows / 3;
+
+  const auto ms = log.numbers("tracking_ms");
+  Chart time;
+  time.set_title(fmt::format("Tracking time per frame and its running median over {} frames", window));
+  time.set_xlabel("frame");
+  time.set_ylabel("ms");
+  time.set_y_from_zero(true);
+  time.add_line(series(ms), {kGrey, 1, false}, "per frame");
+  time.add_line(series(running_median(ms, window)), {kBlue, 2, false}, "running median");
+  cv::Mat p1 = img(cv::Rect(0, 0, img.cols, h));
+  time.draw(p1);
+
+  Chart mem;
+  mem.set_title("Resident memory of the process");
+  mem.set_xlabel("frame");
+  mem.set_ylabel("MiB");
+  mem.set_y_from_zero(true);
+  mem.add_line(series(log.numbers("rss_mb")), {kRed, 2, false}, "resident set size");
+  cv::Mat p2 = img(cv::Rect(0, h, img.cols, h));
+  mem.draw(p2);
+
+  Chart map;
+  // Scaled to one axis: a map has about 100 points and 10 lines per keyframe.
+  map.set_title("Map size: keyframes, points / 100, lines / 10");
+  map.set_xlabel("frame");
+  map.set_ylabel("count");
+  map.set_y_from_zero(true);
+  map.add_line(series(log.numbers("map_keyframes")), {kGreen, 2, false}, "keyframes");
+  map.add_line(series(log.numbers("map_points"), 1e-2), {kBlue, 2, false}, "points / 100");
+  map.add_line(series(log.numbers("map_lines"), 1e-1), {kOrange, 2, false}, "lines / 10");
+  cv::Mat p3 = img(cv::Rect(0, 2 * h, img.cols, img.rows - 2 * h));
+  map.draw(p3);
+
+  const auto path = dir / "resources.png";
+  save_png(img, path);
+  return path;
+}
+
 }  // namespace plslam::eval

@@ -32,4 +32,15 @@ std::vector<std::filesystem::path> write_plots(const EvalResult& r, const std::f
 std::filesystem::path write_tracking_plot(const EvalResult& r, const FrameLog& log, const std::filesystem::path& dir,
                                           const PlotOptions& options = {});
 
+// resources.png, for long runs: tracking ms per frame with its running median over `window`
+// frames, the resident memory, and the map's keyframes, points / 100 and lines / 10, over the
+// frame index.
+// Needs frames.csv's map_* and rss_mb columns (InputError naming the file otherwise). Returns the
+// path written.
+std::filesystem::path write_resources_plot(const FrameLog& log, const std::filesystem::path& dir, int window = 101);
+
+// Whether `log` has the columns write_resources_plot() needs (frames.csv of runs before they
+// existed does not).
+bool has_resource_columns(const FrameLog& log);
+
 }  // namespace plslam::eval
