@@ -8,8 +8,9 @@
 # its running median), the resident memory and the map's size over the frames, and
 # OUT/summary.txt the numbers behind the claims: median tracking ms of the first and the last
 # 1000 frames, resident memory at each lap's end, the map's growth per lap, what reclamation freed
-# (stats.json `reclaimed`), and the ATE. The rendering takes most of the time (about 25 min on
-# 2 cores); a rendered sequence already in OUT/street is reused.
+# (stats.json `reclaimed`), and the ATE. The rendering takes most of the time (1240 s with one
+# rendering thread on 2026-11-26; the run itself about 4 min); a sequence already rendered in
+# OUT/street is reused.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=6000
