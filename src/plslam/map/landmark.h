@@ -67,7 +67,9 @@ class Landmark {
   void increase_found(int n = 1);
   double found_ratio() const;
 
-  bool is_bad() const;
+  // Inline: tracking calls it for every landmark it touches (3 % of a street run's profile as an
+  // out-of-line call).
+  bool is_bad() const { return bad_.load(std::memory_order_acquire); }
   // Flags it bad and removes it from every observing keyframe.
   void set_bad();
   // Hands its observations over to `other` (fusion of duplicates) and turns bad.

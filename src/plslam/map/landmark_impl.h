@@ -134,11 +134,6 @@ double Landmark<D>::found_ratio() const {
 }
 
 template <class D>
-bool Landmark<D>::is_bad() const {
-  return bad_.load(std::memory_order_acquire);
-}
-
-template <class D>
 void Landmark<D>::set_bad() {
   IdMap<KeyFrame, int> obs;
   {
