@@ -18,22 +18,18 @@ KeyFrame* Map::create_keyframe(std::shared_ptr<const FrameData> data, const geom
 MapPoint* Map::create_point(const Eigen::Vector3d& position, KeyFrame* reference, long frame_id) {
   std::lock_guard lock(mutex_);
   ++changes_;
-  auto p = std::make_unique<MapPoint>(next_point_id_++, position, reference, frame_id);
-  MapPoint* raw = p.get();
-  all_points_.emplace(raw, std::move(p));
-  points_.insert(raw);
-  return raw;
+  all_points_.push_back(std::make_unique<MapPoint>(next_point_id_++, position, reference, frame_id));
+  points_.insert(all_points_.back().get());
+  return all_points_.back().get();
 }
 
 MapLine* Map::create_line(const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
                           long frame_id) {
   std::lock_guard lock(mutex_);
   ++changes_;
-  auto l = std::make_unique<MapLine>(next_line_id_++, start, end, reference, frame_id);
-  MapLine* raw = l.get();
-  all_lines_.emplace(raw, std::move(l));
-  lines_.insert(raw);
-  return raw;
+  all_lines_.push_back(std::make_unique<MapLine>(next_line_id_++, start, end, reference, frame_id));
+  lines_.insert(all_lines_.back().get());
+  return all_lines_.back().get();
 }
 
 KeyFrame* Map::restore_keyframe(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw) {
@@ -55,12 +51,13 @@ MapPoint* Map::restore_point(long id, const Eigen::Vector3d& position, KeyFrame*
   std::lock_guard lock(mutex_);
   ++changes_;
   if (id < 0) throw std::invalid_argument("negative point id");
-  auto p = std::make_unique<MapPoint>(id, position, reference, frame_id);
-  MapPoint* raw = p.get();
-  if (!points_.insert(raw).second) throw std::invalid_argument("duplicate point id " + std::to_string(id));
-  all_points_.emplace(raw, std::move(p));
+  all_points_.push_back(std::make_unique<MapPoint>(id, position, reference, frame_id));
+  if (!points_.insert(all_points_.back().get()).second) {
+    all_points_.pop_back();
+    throw std::invalid_argument("duplicate point id " + std::to_string(id));
+  }
   next_point_id_ = std::max(next_point_id_, id + 1);
-  return raw;
+  return all_points_.back().get();
 }
 
 MapLine* Map::restore_line(long id, const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
@@ -68,12 +65,13 @@ MapLine* Map::restore_line(long id, const Eigen::Vector3d& start, const Eigen::V
   std::lock_guard lock(mutex_);
   ++changes_;
   if (id < 0) throw std::invalid_argument("negative line id");
-  auto l = std::make_unique<MapLine>(id, start, end, reference, frame_id);
-  MapLine* raw = l.get();
-  if (!lines_.insert(raw).second) throw std::invalid_argument("duplicate line id " + std::to_string(id));
-  all_lines_.emplace(raw, std::move(l));
+  all_lines_.push_back(std::make_unique<MapLine>(id, start, end, reference, frame_id));
+  if (!lines_.insert(all_lines_.back().get()).second) {
+    all_lines_.pop_back();
+    throw std::invalid_argument("duplicate line id " + std::to_string(id));
+  }
   next_line_id_ = std::max(next_line_id_, id + 1);
-  return raw;
+  return all_lines_.back().get();
 }
 
 Map::NextIds Map::next_ids() const {
@@ -112,18 +110,12 @@ namespace {
 
 // Frees the bad objects of `all` (and drops them from the active set); returns how many.
 template <class Object>
-int free_bad(std::unordered_map<const Object*, std::unique_ptr<Object>>& all, IdSet<Object>& active_set) {
-  int freed = 0;
-  for (auto it = all.begin(); it != all.end();) {
-    if (it->second->is_bad()) {
-      active_set.erase(it->second.get());
-      it = all.erase(it);
-      ++freed;
-    } else {
-      ++it;
-    }
-  }
-  return freed;
+int free_bad(std::vector<std::unique_ptr<Object>>& all, IdSet<Object>& active_set) {
+  return static_cast<int>(std::erase_if(all, [&](const std::unique_ptr<Object>& o) {
+    if (!o->is_bad()) return false;
+    active_set.erase(o.get());
+    return true;
+  }));
 }
 
 }  // namespace

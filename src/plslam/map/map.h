@@ -5,13 +5,11 @@
 // the caller runs only at a point where no thread can hold a pointer to them (see reclaim()).
 // Thread-safe.
 #include <atomic>
-#include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
 #include <set>
 #include <shared_mutex>
-#include <unordered_map>
 #include <vector>
 
 #include "plslam/map/keyframe.h"
@@ -105,9 +103,9 @@ class Map {
   std::atomic<long> big_changes_{0};
   std::atomic<long> changes_{0};
   std::vector<std::unique_ptr<KeyFrame>> all_keyframes_;
-  // Points and lines until freed by reclaim(); keyed by address to free one in O(1).
-  std::unordered_map<const MapPoint*, std::unique_ptr<MapPoint>> all_points_;
-  std::unordered_map<const MapLine*, std::unique_ptr<MapLine>> all_lines_;
+  // Points and lines until freed by reclaim(), in creation order.
+  std::vector<std::unique_ptr<MapPoint>> all_points_;
+  std::vector<std::unique_ptr<MapLine>> all_lines_;
   Reclaimed reclaimed_;  // guarded by mutex_
   mutable IdSet<KeyFrame> keyframes_;
   mutable IdSet<MapPoint> points_;

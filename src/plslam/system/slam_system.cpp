@@ -104,15 +104,13 @@ void System::reclaim_culled() {
   const auto t0 = std::chrono::steady_clock::now();
   if (!mapper_->try_pause()) return;
   if (!loop_closer_ || loop_closer_->try_pause()) {
-    const auto freed = map_.reclaim([this] {
+    map_.reclaim([this] {
       tracker_->drop_bad_landmarks();
       mapper_->drop_bad_landmarks();
     });
     if (loop_closer_) loop_closer_->resume();
     reclaimed_at_keyframe_ = next_keyframe;
     ++reclaim_stats_.runs;
-    reclaim_stats_.points += freed.points;
-    reclaim_stats_.lines += freed.lines;
     reclaim_stats_.ms.push_back(ms_since(t0));
   }
   mapper_->resume();

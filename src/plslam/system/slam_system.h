@@ -90,9 +90,10 @@ class System {
   mapping::LocalMapperStats mapper_stats() const { return mapper_->stats(); }
   // Null without loop closing.
   const loop::LoopCloser* loop_closer() const { return loop_closer_.get(); }
-  // Culled points and lines freed so far (Map::reclaim), and the time it took in tracking's thread.
+  // How often culled points and lines were freed (Map::reclaim; the totals: map().reclaimed()),
+  // and the time each took in tracking's thread.
   struct ReclaimStats {
-    int runs = 0, points = 0, lines = 0;
+    int runs = 0;
     std::vector<double> ms;
   };
   const ReclaimStats& reclaim_stats() const { return reclaim_stats_; }
