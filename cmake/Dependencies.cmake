@@ -10,5 +10,8 @@ find_package(spdlog REQUIRED)
 find_package(yaml-cpp REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(Threads REQUIRED)
-# cpp-httplib (libcpp-httplib-dev, in scripts/install-deps.sh) is left to the browser viewer, whose
-# own target will find it: the library, the CLI and the tests do not use it.
+# cpp-httplib (libcpp-httplib-dev): Debian builds it as a shared library whose header must be
+# compiled with the same feature macros, which its pkg-config file gives. Only the viewer
+# (plslam_viz) links it.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(CPP_HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)

@@ -10,6 +10,8 @@ install(DIRECTORY ${CMAKE_SOURCE_DIR}/src/plslam DESTINATION ${CMAKE_INSTALL_INC
   FILES_MATCHING PATTERN "*.h" PATTERN "*.inc")
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/config/ DESTINATION ${CMAKE_INSTALL_DATADIR}/plslam/config)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/data/vocabulary/ DESTINATION ${CMAKE_INSTALL_DATADIR}/plslam/vocabulary)
+# The browser viewer's page with its three.js files, as the build copied them (cmake/WebAssets.cmake).
+install(DIRECTORY ${CMAKE_BINARY_DIR}/web/ DESTINATION ${CMAKE_INSTALL_DATADIR}/plslam/web)
 install(EXPORT plslamTargets NAMESPACE plslam:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/plslam)
 
 string(REPLACE ";" " " PLSLAM_OPENCV_COMPONENTS "${PLSLAM_OPENCV_COMPONENTS}")

@@ -28,7 +28,7 @@ case "$seconds" in
   ''|*[!0-9]*|0) echo "fuzz.sh: the time per target must be a positive whole number of seconds" >&2; exit 2 ;;
 esac
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(config trajectory euroc_sensor euroc_data_csv euroc_groundtruth kitti_calib kitti_times frame_log image vocabulary bench_configs map_file calibration_file)
+  targets=(config trajectory euroc_sensor euroc_data_csv euroc_groundtruth kitti_calib kitti_times frame_log image vocabulary bench_configs map_file calibration_file run_folder)
 fi
 
 BUILD_DIR=${BUILD_DIR:-build-fuzz}

@@ -17,6 +17,7 @@
 #include "fuzz/targets/fuzz_image.cpp"
 #include "fuzz/targets/fuzz_map_file.cpp"
 #include "fuzz/targets/fuzz_trajectory.cpp"
+#include "fuzz/targets/fuzz_run_folder.cpp"
 #include "fuzz/targets/fuzz_vocabulary.cpp"
 
 namespace plslam::fuzz {
@@ -44,6 +45,7 @@ const Target kTargets[] = {
     {"vocabulary", fuzz_vocabulary},
     {"bench_configs", fuzz_bench_configs},
     {"calibration_file", fuzz_calibration_file},
+    {"run_folder", fuzz_run_folder},
 };
 
 class FuzzReplay : public testing::TestWithParam<Target> {};

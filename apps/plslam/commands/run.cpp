@@ -32,6 +32,9 @@
 #include "plslam/system/run_report.h"
 #include "plslam/system/slam_system.h"
 #include "plslam/system/system_config.h"
+#include "plslam/map/map_snapshot.h"
+#include "plslam/viz/live_viewer.h"
+#include "plslam/viz/scene_document.h"
 
 namespace plslam::cli {
 namespace {
@@ -68,6 +71,10 @@ struct RunArgs {
   std::string camera_right;  // --camera-right DEVICE
   std::string calib;         // --calib FILE, for --video and --camera
   std::string preset;        // --preset euroc|kitti (default: by the dataset's format)
+  bool viewer = false;       // --viewer: the browser viewer, live
+  viz::ViewerServerOptions viewer_server;  // --port, --host
+  double viewer_rate = 5;    // --viewer-rate HZ
+  double viewer_linger = 2;  // --viewer-linger S: serving the final state after the run
 };
 
 // What a run reads: a dataset (KITTI or EuRoC folders, or a video file), or a live camera.
@@ -126,6 +133,23 @@ std::string map_config_text(const RunArgs& args, io::DatasetFormat preset) {
   return j.dump(2);
 }
 
+// What stats.json records of the input: where it was (`plslam view` finds the ground truth there)
+// and the calibration (the viewer draws frustums of its shape).
+nlohmann::json input_json(const RunInput& input) {
+  const auto& c = input.calibration;
+  nlohmann::json j = {{"name", input.name},
+                      {"calibration",
+                       {{"width", c.width}, {"height", c.height}, {"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx},
+                        {"cy", c.cy}, {"baseline", c.baseline}}}};
+  if (input.dataset) {
+    std::error_code ec;
+    const auto root = fs::absolute(input.dataset->root(), ec);
+    j["path"] = (ec ? input.dataset->root() : root).string();
+    j["format"] = io::to_string(input.format);
+  }
+  return j;
+}
+
 // One run into `out_dir`; its stats.json content is left in `stats_out`.
 int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats_out) {
   // Checked before any frame: a bad --out must not be found only when the outputs are written.
@@ -161,6 +185,18 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
                vocabulary ? fmt::format("on ({} words)", vocabulary->size()) : std::string("off"));
 
   system::System slam(calib, options, vocabulary);
+  // The viewer binds before the first frame: a port in use stops the run before it starts.
+  std::unique_ptr<viz::LiveViewer> viewer;
+  if (args.viewer) {
+    viz::SceneInfo base;
+    base.name = input.name;
+    base.camera_model = calib;
+    viz::LiveViewerOptions viewer_options;
+    viewer_options.server = args.viewer_server;
+    viewer_options.rate_hz = args.viewer_rate;
+    viewer = std::make_unique<viz::LiveViewer>(viewer_options, slam.map(), base);
+    std::cout << "viewer: " << viewer->url() << std::endl;
+  }
   nlohmann::json map_stats = {{"loaded", args.load_map.empty() ? nlohmann::json(nullptr) : nlohmann::json(args.load_map)},
                                {"localization_only", args.localize},
                                {"saved", nullptr}};
@@ -190,6 +226,27 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     reached = frame.index + 1;
     ++done;
     const auto now = std::chrono::steady_clock::now();
+    if (viewer) {
+      viz::LiveFrame v;
+      v.frame = r.frame_id;
+      v.state = tracking::to_string(r.track.state);
+      v.tracked = r.track.tracked;
+      if (r.track.tracked && !slam.tracker().records().empty()) {
+        v.T_wc = tracking::Tracker::pose_of(slam.tracker().records().back()).inverse();
+      }
+      v.loops = slam.loop_closer() ? static_cast<long>(slam.loop_closer()->stats().loops.size()) : 0;
+      v.relocalizations = static_cast<long>(slam.tracker().relocalized_frames().size());
+      v.frames = static_cast<long>(report.frames);
+      v.tracked_frames = static_cast<long>(report.tracked_frames);
+      v.fps = static_cast<double>(done) / std::max(1e-9, std::chrono::duration<double>(now - start).count());
+      v.local_keyframes = slam.tracker().local_keyframe_ids();
+      v.local_points = slam.tracker().local_point_ids();
+      v.left = frame.left;  // shares the pixels
+      auto features = slam.tracker().last_tracked_features();
+      v.tracked_points = std::move(features.points);
+      v.tracked_lines = std::move(features.lines);
+      viewer->on_frame(std::move(v));
+    }
     if (!args.quiet && (now - last_progress > std::chrono::seconds(1) || (ds && done == ds->size()))) {
       last_progress = now;
       const double elapsed = std::chrono::duration<double>(now - start).count();
@@ -307,6 +364,14 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     stats_out["realtime"] = realtime_stats;
     const auto stats_text = stats_out.dump(2);
     io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats_text << "\n"; });
+    if (viewer) {
+      viz::Scene empty;  // the page says so instead of waiting for a map that never came
+      empty.info.source = "run";
+      empty.info.name = out_dir.string();
+      empty.info.state = "not initialised";
+      empty.info.frames = static_cast<long>(report.frames);
+      viewer->finish(empty);
+    }
     if (!fatal.empty()) throw InputError("", fatal);
     if (app::stop_requested()) return app::stop_exit_code();
     if (!args.load_map.empty()) {
@@ -343,11 +408,15 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> lines;
   for (const auto* l : slam.map().lines()) lines.emplace_back(l->start(), l->end());
   io::write_ply_lines(out_dir / "map_lines.ply", lines);
+  // The keyframes with their graph, for `plslam view` (the PLY files hold the points and lines).
+  const auto graph = viz::map_graph_json(map::take_snapshot(slam.map())).dump();
+  io::write_file_atomically(out_dir / "map_graph.json", [&](std::ostream& o) { o << graph << "\n"; });
 
   auto stats = with_interruption(report.to_json(slam));
   stats["map"] = map_stats;
   stats["live"] = live_stats;
   stats["realtime"] = realtime_stats;
+  stats["input"] = input_json(input);
   if (ds && ds->ground_truth()) {
     // Tracked poses only: a prediction made while lost is not an estimate to score.
     try {
@@ -374,10 +443,23 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   }
   io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats.dump(2) << "\n"; });
   stats_out = stats;
+  // A signal while the viewer lingers on a finished run does not make the run interrupted.
+  const int rc = app::stop_requested() ? app::stop_exit_code() : 0;
   std::cout << report.summary(slam);
   spdlog::info("outputs written to {}", out_dir.string());
+  if (viewer) {
+    // The page ends on exactly what `plslam view` shows of these outputs.
+    viewer->finish(viz::scene_from_run_folder(out_dir));
+    if (args.viewer_linger > 0 && !app::stop_requested()) {
+      spdlog::info("viewer: serving the final state for {:.0f} s more", args.viewer_linger);
+      const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(args.viewer_linger);
+      while (std::chrono::steady_clock::now() < until && !app::stop_requested()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+    }
+  }
   if (!fatal.empty()) throw InputError("", fatal);
-  return app::stop_requested() ? app::stop_exit_code() : 0;
+  return rc;
 }
 
 // --repeat N: N runs into DIR/run-1 ... DIR/run-N, and DIR/repeat.json with the ATE of each and
@@ -464,7 +546,26 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                                           "Run N times into DIR/run-1..N and report the ATE's median, min and max")
                                ->check(CLI::Range(1, 1000))
                                ->excludes(camera);
-                           return std::function<int()>([args] {
+                           sub.add_flag("--viewer", args->viewer,
+                                        "Serve the browser viewer live during the run (prints its URL)");
+                           sub.add_option("--port", args->viewer_server.port, "--viewer's TCP port (0: any free one)")
+                               ->capture_default_str();
+                           sub.add_option("--host", args->viewer_server.host,
+                                          "--viewer's address; 0.0.0.0 serves every network, an explicit choice")
+                               ->capture_default_str();
+                           sub.add_option("--viewer-rate", args->viewer_rate, "--viewer's updates per second")
+                               ->capture_default_str();
+                           sub.add_option("--viewer-linger", args->viewer_linger,
+                                          "--viewer: seconds the final state stays served after the run")
+                               ->capture_default_str();
+                           return std::function<int()>([args, &sub] {
+                             const bool viewer_options = sub.count("--port") + sub.count("--host") +
+                                                         sub.count("--viewer-rate") + sub.count("--viewer-linger") > 0;
+                             if (viewer_options && !args->viewer) {
+                               throw InputError("", "--port, --host, --viewer-rate and --viewer-linger need --viewer");
+                             }
+                             if (args->viewer && args->repeat > 1) throw InputError("", "--viewer is for one run, not --repeat");
+                             if (!(args->viewer_linger >= 0)) throw InputError("", "--viewer-linger must be >= 0");
                              check_input_args(*args);
                              if (args->repeat > 1) return run_repeated(*args);
                              nlohmann::json stats;

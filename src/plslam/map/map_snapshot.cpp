@@ -16,6 +16,10 @@ MapSnapshot take_snapshot(const Map& map) {
     k.T_wc = kf->pose_inverse();
     if (const auto* parent = kf->parent()) k.parent = parent->id();
     for (const auto* other : kf->loop_edges()) k.loop_edges.push_back(other->id());
+    for (const auto* other : kf->covisibles()) {
+      // A connection erased between the two calls weighs 0: the edge is gone.
+      if (const int w = kf->weight(other); w > 0) k.covisibility.emplace_back(other->id(), w);
+    }
     s.keyframes.push_back(std::move(k));
   }
   for (const auto* p : map.points()) s.points.push_back({p->id(), p->position()});

@@ -2,6 +2,7 @@
 // A read-only copy of the map for readers outside the SLAM threads (the public API, a viewer, a
 // writer): plain values, no pointers into the live map, so it can be read at leisure while
 // tracking, local mapping and loop closing go on.
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -17,6 +18,7 @@ struct KeyframeSnapshot {
   geometry::SE3 T_wc;
   long parent = -1;                  // spanning-tree parent, -1 for a root
   std::vector<long> loop_edges;      // keyframes a loop closure connected it to
+  std::vector<std::pair<long, int>> covisibility;  // keyframe id, weight; by decreasing weight
 };
 
 struct PointSnapshot {

@@ -54,6 +54,36 @@ geometry::SE3 Tracker::predicted_pose(const Frame& f) const {
   return predict_pose(*velocity_, velocity_dt_, f.data->timestamp - last_->data->timestamp, last_->T_cw);
 }
 
+std::vector<long> Tracker::local_keyframe_ids() const {
+  std::vector<long> ids;
+  ids.reserve(local_keyframes_.size());
+  for (const auto* kf : local_keyframes_) ids.push_back(kf->id());
+  return ids;
+}
+
+std::vector<long> Tracker::local_point_ids() const {
+  std::vector<long> ids;
+  ids.reserve(local_points_.size());
+  for (const auto* p : local_points_) ids.push_back(p->id());
+  return ids;
+}
+
+Tracker::TrackedFeatures Tracker::last_tracked_features() const {
+  TrackedFeatures out;
+  if (!last_) return out;
+  const auto& f = *last_;
+  for (std::size_t i = 0; i < f.points.size(); ++i) {
+    if (f.points[i] && !f.point_outlier[i]) out.points.push_back(f.data->keypoints[i].pt);
+  }
+  for (std::size_t i = 0; i < f.lines.size(); ++i) {
+    if (f.lines[i] && !f.line_outlier[i]) {
+      const auto& s = f.data->lines[i].segment;
+      out.lines.emplace_back(s.start, s.end);
+    }
+  }
+  return out;
+}
+
 geometry::SE3 Tracker::pose_of(const FrameRecord& r) {
   geometry::SE3 T_cr = r.T_cr;
   map::KeyFrame* ref = r.reference;

@@ -169,6 +169,16 @@ class Tracker {
   const std::vector<long>& relocalized_frames() const { return relocalized_frames_; }
   const std::vector<long>& new_segment_frames() const { return new_segment_frames_; }
   const std::vector<FrameRecord>& records() const { return records_; }
+  // The ids of the local map the last frame was tracked against (the live viewer highlights it);
+  // tracking thread, between frames.
+  std::vector<long> local_keyframe_ids() const;
+  std::vector<long> local_point_ids() const;
+  // Where the last frame's matched (inlier) points and lines lie in its left image, to draw them.
+  struct TrackedFeatures {
+    std::vector<cv::Point2f> points;
+    std::vector<std::pair<cv::Point2f, cv::Point2f>> lines;
+  };
+  TrackedFeatures last_tracked_features() const;
   // The pose of a record with every keyframe's current estimate (call with local mapping idle).
   static geometry::SE3 pose_of(const FrameRecord& r);
 

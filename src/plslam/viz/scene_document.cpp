@@ -1,0 +1,314 @@
+#include "plslam/viz/scene_document.h"
+
+#include <algorithm>
+#include <iterator>
+#include <set>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "plslam/core/error.h"
+#include "plslam/core/input_file.h"
+#include "plslam/eval/evaluate.h"
+#include "plslam/io/dataset.h"
+#include "plslam/io/map_export.h"
+#include "plslam/io/trajectory_io.h"
+#include "plslam/system/map_file.h"
+
+namespace plslam::viz {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Positions go out as floats: a tenth of a millimetre is far below what the page can show, and
+// the document of a 100k-point map is half the size with 9 digits instead of 17.
+void append(json& flat, const Eigen::Vector3d& p) {
+  for (int i = 0; i < 3; ++i) flat.push_back(static_cast<float>(p[i]));
+}
+
+json pose_row_major(const geometry::SE3& T) {
+  json out = json::array();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out.push_back(static_cast<float>(T.rotation()(r, c)));
+    out.push_back(static_cast<float>(T.translation()[r]));
+  }
+  return out;
+}
+
+template <typename T>
+json optional_json(const std::optional<T>& v) {
+  return v ? json(*v) : json(nullptr);
+}
+
+std::string read_text(const fs::path& path) {
+  auto in = open_input_file(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+json parse_json_file(const fs::path& path) {
+  try {
+    return json::parse(read_text(path));
+  } catch (const json::exception& e) {
+    throw InputError(path.string(), std::string("not JSON: ") + e.what());
+  }
+}
+
+// A whole number from stats.json, or nullopt when the key is absent or null.
+std::optional<long> optional_count(const json& j, const char* key, const fs::path& file) {
+  if (!j.contains(key) || j[key].is_null()) return std::nullopt;
+  if (!j[key].is_number_integer()) throw InputError(file.string(), fmt::format("'{}' is not a whole number", key));
+  return j[key].get<long>();
+}
+
+// The dataset's ground truth, paired with the run's poses by time and brought into the map's
+// world by the inverse of the se3 alignment that scored the run (the same ATE as stats.json).
+void add_ground_truth(const json& stats, SceneInfo& info, const Trajectory& estimate) {
+  if (!stats.contains("input") || !stats["input"].is_object() || !stats["input"].contains("path") ||
+      !stats["input"]["path"].is_string()) {
+    return;  // a live camera, or a folder written before runs recorded their input
+  }
+  const fs::path dataset_path = stats["input"]["path"].get<std::string>();
+  std::error_code ec;
+  if (!fs::exists(dataset_path, ec)) {
+    spdlog::warn("{}: not found, the ground truth is not shown", dataset_path.string());
+    return;  // moved since: the map is still worth seeing
+  }
+  try {
+    const auto dataset = io::open_dataset(dataset_path);
+    if (!dataset->ground_truth()) return;
+    eval::EvalOptions options;
+    options.align = eval::AlignMode::kSE3;
+    const auto result = eval::evaluate(*dataset->ground_truth(), estimate, options);
+    const auto& a = result.alignment;
+    for (const auto& g : result.gt) {
+      info.ground_truth.push_back(a.R.transpose() * (g.T.translation() - a.t) / a.s);
+    }
+    info.ate_rmse_m = result.ape_trans_stats.rmse;
+  } catch (const InputError& e) {
+    // A video input, or too few tracked poses to align: the map without the ground truth.
+    spdlog::warn("no ground truth shown: {}", e.what());
+  }
+}
+
+}  // namespace
+
+json map_graph_json(const map::MapSnapshot& map) {
+  json keyframes = json::array();
+  for (const auto& kf : map.keyframes) {
+    json covisibility = json::array();
+    for (const auto& [id, weight] : kf.covisibility) covisibility.push_back({id, weight});
+    keyframes.push_back({{"id", kf.id},
+                         {"t", kf.timestamp},
+                         {"T_wc", pose_row_major(kf.T_wc)},
+                         {"parent", kf.parent},
+                         {"loop_edges", kf.loop_edges},
+                         {"covisibility", covisibility}});
+  }
+  return {{"version", 1}, {"keyframes", keyframes}};
+}
+
+void parse_map_graph(const std::string& text, const std::string& source, map::MapSnapshot& map) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::exception& e) {
+    throw InputError(source, std::string("not JSON: ") + e.what());
+  }
+  auto fail = [&](std::size_t i, const std::string& problem) {
+    return InputError(source, fmt::format("keyframe {}: {}", i, problem));
+  };
+  if (!j.is_object() || !j.contains("version") || j["version"] != 1 || !j.contains("keyframes") ||
+      !j["keyframes"].is_array()) {
+    throw InputError(source, "expected {\"version\": 1, \"keyframes\": [...]}");
+  }
+  std::set<long> ids;
+  for (std::size_t i = 0; i < j["keyframes"].size(); ++i) {
+    const auto& k = j["keyframes"][i];
+    if (!k.is_object()) throw fail(i, "not an object");
+    map::KeyframeSnapshot kf;
+    try {
+      kf.id = k.at("id").get<long>();
+      kf.timestamp = k.at("t").get<double>();
+      kf.parent = k.at("parent").get<long>();
+      const auto T = k.at("T_wc").get<std::vector<double>>();
+      if (T.size() != 12) throw fail(i, "T_wc must hold 12 numbers");
+      Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 4; ++c) M(r, c) = T[static_cast<std::size_t>(4 * r + c)];
+      }
+      if (!M.allFinite()) throw fail(i, "T_wc is not finite");
+      kf.T_wc = geometry::SE3::from_matrix(M);
+      kf.loop_edges = k.at("loop_edges").get<std::vector<long>>();
+      for (const auto& e : k.at("covisibility")) {
+        const auto pair = e.get<std::vector<long>>();
+        if (pair.size() != 2) throw fail(i, "a covisibility entry is [keyframe id, weight]");
+        kf.covisibility.emplace_back(pair[0], static_cast<int>(pair[1]));
+      }
+    } catch (const json::exception& e) {
+      throw fail(i, e.what());
+    }
+    if (!ids.insert(kf.id).second) throw fail(i, fmt::format("id {} appears twice", kf.id));
+    map.keyframes.push_back(std::move(kf));
+  }
+}
+
+json scene_document(const map::MapSnapshot& map, const SceneInfo& info) {
+  json ids = json::array(), poses = json::array(), parents = json::array(), loop_edges = json::array(),
+       covisibility = json::array();
+  for (const auto& kf : map.keyframes) {
+    ids.push_back(kf.id);
+    for (auto& v : pose_row_major(kf.T_wc)) poses.push_back(std::move(v));
+    parents.push_back(kf.parent);
+    // Each edge once, from its lower id.
+    for (const long other : kf.loop_edges) {
+      if (kf.id < other) loop_edges.push_back({kf.id, other});
+    }
+    for (const auto& [other, weight] : kf.covisibility) {
+      if (kf.id < other) covisibility.push_back({kf.id, other, weight});
+    }
+  }
+  json point_ids = json::array(), point_xyz = json::array(), line_ids = json::array(), line_xyz = json::array();
+  for (const auto& p : map.points) {
+    point_ids.push_back(p.id);
+    append(point_xyz, p.position);
+  }
+  for (const auto& l : map.lines) {
+    line_ids.push_back(l.id);
+    append(line_xyz, l.start);
+    append(line_xyz, l.end);
+  }
+  json trajectory = json::array();
+  for (const auto& c : info.trajectory) append(trajectory, c);
+  json ground_truth = nullptr;
+  if (!info.ground_truth.empty()) {
+    json positions = json::array();
+    for (const auto& g : info.ground_truth) append(positions, g);
+    ground_truth = {{"positions", positions}, {"ate_rmse_m", optional_json(info.ate_rmse_m)}};
+  }
+  json camera_model = nullptr;
+  if (const auto& c = info.camera_model) {
+    camera_model = {{"width", c->width}, {"height", c->height}, {"fx", c->fx}, {"fy", c->fy}, {"cx", c->cx}, {"cy", c->cy}};
+  }
+  json local_map = nullptr;
+  if (info.local_map) local_map = {{"keyframes", info.local_map->first}, {"points", info.local_map->second}};
+  return {{"version", 1},
+          {"source", info.source},
+          {"name", info.name},
+          {"final", info.final},
+          {"revision", info.revision},
+          {"counts",
+           {{"frame", optional_json(info.frame)},
+            {"frames", optional_json(info.frames)},
+            {"tracked", optional_json(info.tracked)},
+            {"keyframes", map.keyframes.size()},
+            {"points", map.points.size()},
+            {"lines", map.lines.size()},
+            {"loops", optional_json(info.loops)},
+            {"loop_edges", loop_edges.size()},
+            {"relocalizations", optional_json(info.relocalizations)},
+            {"state", optional_json(info.state)},
+            {"fps", optional_json(info.fps)}}},
+          {"keyframes", {{"ids", ids}, {"poses", poses}, {"parents", parents}}},
+          {"loop_edges", loop_edges},
+          {"covisibility", covisibility},
+          {"trajectory", trajectory},
+          {"camera", info.camera ? pose_row_major(*info.camera) : json(nullptr)},
+          {"ground_truth", ground_truth},
+          {"points", {{"ids", point_ids}, {"xyz", point_xyz}}},
+          {"lines", {{"ids", line_ids}, {"xyz", line_xyz}}},
+          {"local_map", local_map},
+          {"camera_model", camera_model}};
+}
+
+Scene scene_from_run_folder(const fs::path& folder) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) throw InputError(folder.string(), "not a folder");
+  Scene scene;
+  auto& info = scene.info;
+  info.source = "run";
+  info.name = folder.string();
+  const auto stats_path = folder / "stats.json";
+  const json stats = parse_json_file(stats_path);
+  if (!stats.is_object()) throw InputError(stats_path.string(), "not a JSON object");
+  info.frames = optional_count(stats, "frames", stats_path);
+  info.tracked = optional_count(stats, "tracked_frames", stats_path);
+  if (info.frames && *info.frames > 0) info.frame = *info.frames - 1;
+  if (stats.contains("loops") && stats["loops"].is_array()) info.loops = static_cast<long>(stats["loops"].size());
+  if (stats.contains("relocalizations") && stats["relocalizations"].is_object()) {
+    info.relocalizations = optional_count(stats["relocalizations"], "count", stats_path);
+  }
+  const bool interrupted = stats.contains("interrupted_by") && !stats["interrupted_by"].is_null();
+  const bool complete = stats.contains("complete") && stats["complete"] == true;
+  info.state = interrupted ? "interrupted" : complete ? "finished" : "incomplete";
+
+  const auto trajectory = io::read_trajectory(folder / "trajectory.tum", io::TrajectoryFormat::kTum);
+  for (const auto& p : trajectory) info.trajectory.push_back(p.T.translation());
+  if (!trajectory.empty()) info.camera = geometry::SE3(trajectory.back().T);
+
+  const auto graph_path = folder / "map_graph.json";
+  if (fs::exists(graph_path, ec)) {
+    parse_map_graph(read_text(graph_path), graph_path.string(), scene.map);
+  } else {
+    // Written before map_graph.json: the keyframes' poses, with ids in time order and no graph.
+    const auto kfs = io::read_trajectory(folder / "keyframes.tum", io::TrajectoryFormat::kTum);
+    for (std::size_t i = 0; i < kfs.size(); ++i) {
+      map::KeyframeSnapshot k;
+      k.id = static_cast<long>(i);
+      k.timestamp = kfs[i].t;
+      k.T_wc = geometry::SE3(kfs[i].T);
+      scene.map.keyframes.push_back(std::move(k));
+    }
+  }
+  const auto points = io::read_ply_points(folder / "map_points.ply");
+  for (std::size_t i = 0; i < points.size(); ++i) scene.map.points.push_back({static_cast<long>(i), points[i]});
+  const auto lines = io::read_ply_lines(folder / "map_lines.ply");
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    scene.map.lines.push_back({static_cast<long>(i), lines[i].first, lines[i].second});
+  }
+  if (stats.contains("input") && stats["input"].is_object() && stats["input"].contains("calibration")) {
+    const auto& c = stats["input"]["calibration"];
+    try {
+      StereoCalibration calib;
+      calib.width = c.at("width").get<int>();
+      calib.height = c.at("height").get<int>();
+      calib.fx = c.at("fx").get<double>();
+      calib.fy = c.at("fy").get<double>();
+      calib.cx = c.at("cx").get<double>();
+      calib.cy = c.at("cy").get<double>();
+      calib.baseline = c.at("baseline").get<double>();
+      info.camera_model = calib;
+    } catch (const json::exception& e) {
+      throw InputError(stats_path.string(), std::string("input.calibration: ") + e.what());
+    }
+  }
+  add_ground_truth(stats, info, trajectory);
+  return scene;
+}
+
+Scene scene_from_map_file(const fs::path& file) {
+  const auto contents = system::load_map_file(file);
+  Scene scene;
+  auto& info = scene.info;
+  info.source = "map";
+  info.name = file.string();
+  info.state = "map";
+  info.camera_model = contents.meta.calib;
+  for (const auto& kf : contents.keyframes) {
+    map::KeyframeSnapshot k;
+    k.id = kf.id;
+    k.timestamp = kf.data ? kf.data->timestamp : 0.0;
+    k.T_wc = kf.T_cw.inverse();
+    k.parent = kf.parent;
+    k.loop_edges = kf.loop_edges;
+    k.covisibility = kf.covisibility;
+    info.trajectory.push_back(k.T_wc.translation());
+    scene.map.keyframes.push_back(std::move(k));
+  }
+  if (!scene.map.keyframes.empty()) info.camera = scene.map.keyframes.back().T_wc;
+  for (const auto& p : contents.points) scene.map.points.push_back({p.id, p.a});
+  for (const auto& l : contents.lines) scene.map.lines.push_back({l.id, l.a, l.b});
+  return scene;
+}
+
+}  // namespace plslam::viz

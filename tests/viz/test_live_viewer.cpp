@@ -1,0 +1,178 @@
+// The live viewer: the deltas it publishes, and `plslam run --viewer` watched by a client from
+// the first frames to the final state.
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <future>
+#include <regex>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "plslam/viz/live_viewer.h"
+#include "support/test_support.h"
+
+// Last: <resolv.h>, which it brings, defines `_res`, a name Eigen's headers use.
+#include <httplib.h>
+
+namespace plslam::viz {
+namespace {
+
+using nlohmann::json;
+
+map::MapSnapshot two_keyframes() {
+  map::MapSnapshot m;
+  for (long i = 0; i < 2; ++i) {
+    map::KeyframeSnapshot k;
+    k.id = i;
+    k.T_wc = geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(static_cast<double>(i), 0, 0));
+    k.parent = i - 1;
+    m.keyframes.push_back(k);
+  }
+  m.points = {{1, {0, 0, 1}}, {2, {0, 0, 2}}, {3, {0, 0, 3}}};
+  m.lines = {{7, {0, 0, 1}, {1, 0, 1}}};
+  return m;
+}
+
+TEST(SceneDelta, HoldsWhatWasAddedMovedAndRemovedAndNothingElse) {
+  const auto before = two_keyframes();
+  auto after = before;
+  after.points[0].position.z() += 0.0005;  // below 1 mm: not sent
+  after.points[1].position.z() += 0.01;    // moved
+  after.points.erase(after.points.begin() + 2);  // point 3 culled
+  after.points.push_back({4, {1, 1, 1}});  // new
+  after.keyframes[1].T_wc = geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1.5, 0, 0));
+  map::KeyframeSnapshot k;
+  k.id = 2;
+  k.parent = 1;
+  after.keyframes.push_back(k);
+  after.keyframes[0].covisibility = {{2, 30}};
+  after.keyframes[2].covisibility = {{0, 30}};
+  SceneInfo info;
+  info.trajectory = {{0, 0, 0}, {0.5, 0, 0}, {1, 0, 0}};
+  info.frame = 9;
+  info.final = false;
+  const json d = scene_delta(before, after, info, 2, 5);
+  EXPECT_EQ(d["revision"], 5);
+  EXPECT_EQ(d["final"], false);
+  EXPECT_EQ(d["points"]["ids"], json({2, 4}));
+  EXPECT_EQ(d["points"]["xyz"].size(), 6u);
+  EXPECT_EQ(d["points_removed"], json({3}));
+  EXPECT_EQ(d["lines"]["ids"], json::array());
+  EXPECT_EQ(d["lines_removed"], json::array());
+  EXPECT_EQ(d["keyframes"]["ids"], json({1, 2}));
+  EXPECT_EQ(d["keyframes_removed"], json::array());
+  EXPECT_EQ(d["covisibility"], json({{0, 2, 30}}));
+  EXPECT_EQ(d["trajectory_append"], json({1.0, 0.0, 0.0}));  // only what the page does not have
+  EXPECT_EQ(d["counts"]["points"], 3);
+  EXPECT_EQ(d["counts"]["keyframes"], 3);
+  EXPECT_EQ(d["counts"]["frame"], 9);
+  // Nothing changed: empty lists, and the graph is not resent.
+  const json none = scene_delta(after, after, info, 3, 6);
+  EXPECT_TRUE(none["points"]["ids"].empty());
+  EXPECT_TRUE(none["keyframes"]["ids"].empty());
+  EXPECT_TRUE(none["trajectory_append"].empty());
+  EXPECT_FALSE(none.contains("covisibility"));
+}
+
+// Reads the "viewer: URL" line of a command started with popen.
+struct CliProcess {
+  FILE* pipe = nullptr;
+  explicit CliProcess(const std::string& args) {
+    pipe = ::popen((std::string(PLSLAM_CLI_PATH) + " " + args + " 2>/dev/null").c_str(), "r");
+  }
+  std::string read_line() {
+    char buf[512];
+    return pipe && std::fgets(buf, sizeof buf, pipe) ? std::string(buf) : std::string();
+  }
+  int close() {
+    const int status = pipe ? ::pclose(pipe) : -1;
+    pipe = nullptr;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  ~CliProcess() { close(); }
+};
+
+// A client follows a run from its first revisions to the end by deltas, as the page does, and
+// ends with the counts of stats.json.
+TEST(LiveViewerRun, AClientFollowsTheMapAsItGrowsAndEndsOnTheFinalState) {
+  test::TempDir dir;
+  const auto seq = dir.path() / "office";
+  ASSERT_EQ(test::run_cli("synth --scene office --frames 150 --seed 3 --out " + seq.string()).exit_code, 0);
+  CliProcess run("run " + seq.string() + " --out " + (dir.path() / "out").string() +
+                 " --quiet --viewer --port 0 --viewer-rate 10 --viewer-linger 3");
+  const std::string line = run.read_line();
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(line, m, std::regex(R"(viewer: http://127\.0\.0\.1:(\d+)/)"))) << line;
+  httplib::Client client("127.0.0.1", std::stoi(m[1]));
+  client.set_read_timeout(std::chrono::seconds(10));
+  auto res = client.Get("/api/scene");
+  ASSERT_TRUE(res);
+  json doc = json::parse(res->body);
+  EXPECT_EQ(doc["source"], "live");
+  long revision = doc["revision"];
+  std::map<long, int> keyframes_seen;  // keyframe count -> how often seen
+  std::set<long> points;
+  for (const auto& id : doc["points"]["ids"]) points.insert(id.get<long>());
+  bool final = false;
+  int deltas = 0;
+  for (int i = 0; i < 600 && !final; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    res = client.Get("/api/scene?since=" + std::to_string(revision));
+    ASSERT_TRUE(res);
+    if (res->status == 204) continue;
+    ASSERT_EQ(res->status, 200);
+    const json reply = json::parse(res->body);
+    if (reply.value("type", "") == "delta") {
+      EXPECT_EQ(reply["from"], revision);
+      for (const auto& d : reply["deltas"]) {
+        ++deltas;
+        for (const auto& id : d["points"]["ids"]) points.insert(id.get<long>());
+        for (const auto& id : d["points_removed"]) points.erase(id.get<long>());
+        // Applying the deltas gives the map the server counts.
+        EXPECT_EQ(points.size(), d["counts"]["points"].get<std::size_t>());
+        keyframes_seen[d["counts"]["keyframes"].get<long>()]++;
+        final = d["final"];
+      }
+    } else {
+      final = reply["final"];
+      doc = reply;
+    }
+    revision = reply["revision"];
+  }
+  ASSERT_TRUE(final) << "the run never published its final state";
+  EXPECT_GT(deltas, 5);
+  EXPECT_GE(keyframes_seen.size(), 3u) << "the keyframe count did not grow while watched";
+  EXPECT_EQ(doc["source"], "run");
+  const json stats = json::parse(test::read_file(dir.path() / "out/stats.json"));
+  EXPECT_EQ(doc["counts"]["keyframes"], stats["keyframes"]);
+  EXPECT_EQ(doc["counts"]["points"], stats["map_points"]);
+  EXPECT_EQ(doc["counts"]["lines"], stats["map_lines"]);
+  EXPECT_EQ(doc["counts"]["frames"], stats["frames"]);
+  EXPECT_NEAR(doc["ground_truth"]["ate_rmse_m"].get<double>(), stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(),
+              1e-9);
+  EXPECT_EQ(run.close(), 0);
+}
+
+TEST(LiveViewerRun, APortInUseStopsTheRunBeforeItsFirstFrame) {
+  test::TempDir dir;
+  httplib::Server blocker;
+  const int port = blocker.bind_to_any_port("127.0.0.1");
+  ASSERT_GT(port, 0);
+  const auto seq = dir.path() / "office";
+  ASSERT_EQ(test::run_cli("synth --scene office --frames 5 --seed 3 --out " + seq.string()).exit_code, 0);
+  const auto r = test::run_cli("run " + seq.string() + " --out " + (dir.path() / "out").string() +
+                               " --viewer --port " + std::to_string(port));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("127.0.0.1:" + std::to_string(port) + ": cannot serve the viewer there (the port is in use"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out/stats.json"));  // no frame was processed
+  const auto bad = test::run_cli("run x --out " + (dir.path() / "o").string() + " --port 9000");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("need --viewer"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+}  // namespace plslam::viz
