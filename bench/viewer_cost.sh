@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# What the live viewer costs tracking (issue 17): the same sequence run N times each way,
+# alternating, in the default concurrent mode, and the median of each run's median tracking ms.
+#
+#   bench/viewer_cost.sh [--runs N] [--dataset DIR] OUT
+#
+#   off      plslam run without --viewer
+#   poller   --viewer at 5 Hz with a client that follows it as the page does (deltas every 200 ms,
+#            the camera image when it changes): the server's side, as with a browser on another
+#            machine
+#   browser  --viewer at 5 Hz with the page open in headless Chromium on this same machine: adds
+#            the browser's software rendering (SwiftShader) to the two cores
+# Default dataset: the office loop (480 frames, seed 1), rendered into OUT/office when missing.
+# OUT/summary.txt has one line per mode: the runs' medians and the ratio to `off`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+runs=5
+dataset=""
+while [ $# -gt 1 ]; do
+  case "$1" in
+    --runs) runs=$2; shift 2 ;;
+    --dataset) dataset=$2; shift 2 ;;
+    *) echo "viewer_cost.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+out=${1:?usage: bench/viewer_cost.sh [--runs N] [--dataset DIR] OUT}
+plslam=${PLSLAM:-build/plslam}
+[ -x "$plslam" ] || { echo "viewer_cost.sh: $plslam not built" >&2; exit 2; }
+mkdir -p "$out"
+if [ -z "$dataset" ]; then
+  dataset="$out/office"
+  [ -d "$dataset/mav0" ] || "$plslam" synth --scene office --frames 480 --loop --seed 1 --out "$dataset" >/dev/null 2>&1
+fi
+
+# Follows the live viewer until its final revision, as web/scene_client.js does.
+poller() {
+  python3 - "$1" <<'PY'
+import json, sys, time, urllib.request
+url = sys.argv[1]
+revision, final = None, False
+while not final:
+    q = url + "api/scene" + ("" if revision is None else f"?since={revision}")
+    try:
+        with urllib.request.urlopen(q, timeout=10) as r:
+            if r.status == 200:
+                d = json.loads(r.read())
+                final = d["deltas"][-1]["final"] if d.get("type") == "delta" else d["final"]
+                revision = d["revision"]
+                if not final:
+                    urllib.request.urlopen(url + "api/image.jpg", timeout=10).read()
+    except urllib.error.HTTPError:
+        pass  # 404 for the image before the first frame
+    time.sleep(0.2)
+PY
+}
+
+browser() {
+  node bench/viewer_follow.mjs "$1"
+}
+
+run_one() {  # mode, index
+  local mode=$1 i=$2 dir="$out/$1-$2"
+  rm -rf "$dir"
+  if [ "$mode" = off ]; then
+    "$plslam" run "$dataset" --out "$dir" --quiet >/dev/null 2>&1
+  else
+    "$plslam" run "$dataset" --out "$dir" --quiet --viewer --port 0 --viewer-linger 5 >"$dir.stdout" 2>/dev/null &
+    local pid=$! url=""
+    for _ in $(seq 100); do
+      url=$(grep -o 'http://[0-9.]*:[0-9]*/' "$dir.stdout" 2>/dev/null || true)
+      [ -n "$url" ] && break
+      sleep 0.1
+    done
+    "$mode" "$url"
+    kill -TERM "$pid" 2>/dev/null || true
+    wait "$pid" || true
+  fi
+  python3 -c "import json; print(json.load(open('$dir/stats.json'))['tracking_ms']['median'])" >> "$out/$mode.txt"
+}
+
+rm -f "$out"/{off,poller,browser}.txt
+for i in $(seq "$runs"); do
+  for mode in off poller browser; do
+    run_one "$mode" "$i"
+    echo "run $i $mode: $(tail -1 "$out/$mode.txt") ms"
+  done
+done
+python3 - "$out" <<'PY' | tee "$out/summary.txt"
+import statistics, sys
+out = sys.argv[1]
+med = {m: statistics.median(float(x) for x in open(f"{out}/{m}.txt")) for m in ("off", "poller", "browser")}
+for m in ("off", "poller", "browser"):
+    runs = " ".join(f"{float(x):.1f}" for x in open(f"{out}/{m}.txt"))
+    print(f"{m:8s} median {med[m]:.2f} ms/frame (runs: {runs}), ratio to off {med[m] / med['off']:.3f}")
+PY
