@@ -58,17 +58,18 @@ SANITIZER_SKIP='^(RunEndToEnd\.(CorridorLinesLowerTheFrameToFrameError|Kitti01Hi
 # prefetch), and the robustness suites that run a threaded command (the image prefetch of
 # `plslam run`, synth and bench stopped by a signal), the keyframe database (local mapping adds,
 # tracking queries), a concurrent run that relocalizes (RelocalizationConcurrent), and loop closing
-# (LoopClosingConcurrent: its thread and global BA on a map, and `plslam run` with all threads); the suites on reading user input (InputRobustness,
+# (LoopClosingConcurrent: its thread and global BA on a map, and `plslam run` with all threads), the
+# browser viewer's server threads and its publisher beside a run (ViewerServer, LiveViewerRun); the suites on reading user input (InputRobustness,
 # JsonStdoutRobustness, ConfigRobustness) test parsing and checks, not threads, and run in the
 # other two stages. The sequential end-to-end accuracy runs
 # are left to the other stages: in them local mapping runs in the tracking thread, and
 # RunConcurrent covers every seam between the threads.
-TSAN_SUITES='WorkerPool|LocalMapperThread|MapSnapshotConcurrent|BundleAdjustment|StereoPoints|FrameStream|LiveCapture|VideoDataset|SynthFormats|SynthDeterminism|RunConcurrent|TimeRobustness|SignalRobustness|KeyframeDatabase|RelocalizationConcurrent|LoopClosingConcurrent'
+TSAN_SUITES='WorkerPool|LocalMapperThread|MapSnapshotConcurrent|BundleAdjustment|StereoPoints|FrameStream|LiveCapture|VideoDataset|SynthFormats|SynthDeterminism|RunConcurrent|TimeRobustness|SignalRobustness|KeyframeDatabase|RelocalizationConcurrent|LoopClosingConcurrent|ViewerServer|LiveViewerRun'
 TSAN_TESTS="^(${TSAN_SUITES})\\."
 # The test executables that hold them (tests/<folder> -> test_<folder>), plus the CLI they run: the
 # TSan stage builds only these. A TSan suite in another folder stops the script (checked below),
 # so no test can drop out of the stage silently.
-TSAN_TARGETS='plslam test_core test_features test_io test_loop test_map test_mapping test_optim test_place test_robustness test_synth test_system'
+TSAN_TARGETS='plslam test_core test_features test_io test_loop test_map test_mapping test_optim test_place test_robustness test_synth test_system test_viz'
 for f in $(grep -rlE "^(TEST|TEST_F|TEST_P)\((${TSAN_SUITES})[A-Za-z]*," tests); do
   folder=$(echo "$f" | cut -d/ -f2)
   case " $TSAN_TARGETS " in

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <future>
+#include <algorithm>
 #include <cstdlib>
 #include <map>
 #include <set>
@@ -101,7 +102,7 @@ struct CliProcess {
 TEST(LiveViewerRun, AClientFollowsTheMapAsItGrowsAndEndsOnTheFinalState) {
   test::TempDir dir;
   const auto seq = dir.path() / "office";
-  ASSERT_EQ(test::run_cli("synth --scene office --frames 150 --seed 3 --out " + seq.string()).exit_code, 0);
+  ASSERT_EQ(test::run_cli("synth --scene office --frames 100 --seed 3 --out " + seq.string()).exit_code, 0);
   CliProcess run("run " + seq.string() + " --out " + (dir.path() / "out").string() +
                  " --quiet --viewer --port 0 --viewer-rate 10 --viewer-linger 3");
   // std::regex is avoided: GCC 12 warns inside <regex> at -O1 (the sanitizer builds), -Werror.
@@ -177,6 +178,25 @@ TEST(LiveViewerRun, APortInUseStopsTheRunBeforeItsFirstFrame) {
   const auto bad = test::run_cli("run x --out " + (dir.path() / "o").string() + " --port 9000");
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("need --viewer"), std::string::npos) << bad.err;
+}
+
+TEST(ViewCli, BadTargetsAndOptionsAreOneLineErrors) {
+  test::TempDir dir;
+  std::ofstream(dir.path() / "not_a_map.plmap") << "hello";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"view " + (dir.path() / "missing.plmap").string(), "missing.plmap: map file not found"},
+      {"view " + dir.path().string(), "stats.json: file not found"},
+      {"view " + (dir.path() / "not_a_map.plmap").string(), "not_a_map.plmap: "},
+      {"view " + dir.path().string() + " --port 70000", "--port 70000: must be 0..65535"},
+      {"view " + dir.path().string() + " --assets " + dir.path().string(), "no index.html"},
+  };
+  for (const auto& [args, message] : cases) {
+    const auto r = test::run_cli(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_TRUE(r.out.empty()) << "no URL for a viewer that is not serving: " << r.out;
+  }
 }
 
 }  // namespace
