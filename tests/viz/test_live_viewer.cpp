@@ -52,6 +52,8 @@ TEST(SceneDelta, HoldsWhatWasAddedMovedAndRemovedAndNothingElse) {
   after.keyframes.push_back(k);
   after.keyframes[0].covisibility = {{2, 30}};
   after.keyframes[2].covisibility = {{0, 30}};
+  after.keyframes[0].loop_edges = {2};
+  after.keyframes[2].loop_edges = {0};
   SceneInfo info;
   info.trajectory = {{0, 0, 0}, {0.5, 0, 0}, {1, 0, 0}};
   info.frame = 9;
@@ -67,6 +69,7 @@ TEST(SceneDelta, HoldsWhatWasAddedMovedAndRemovedAndNothingElse) {
   EXPECT_EQ(d["keyframes"]["ids"], json({1, 2}));
   EXPECT_EQ(d["keyframes_removed"], json::array());
   EXPECT_EQ(d["covisibility"], json({{0, 2, 30}}));
+  EXPECT_EQ(d["loop_edges"], json({{0, 2}}));
   EXPECT_EQ(d["trajectory_append"], json({1.0, 0.0, 0.0}));  // only what the page does not have
   EXPECT_EQ(d["counts"]["points"], 3);
   EXPECT_EQ(d["counts"]["keyframes"], 3);
@@ -77,6 +80,9 @@ TEST(SceneDelta, HoldsWhatWasAddedMovedAndRemovedAndNothingElse) {
   EXPECT_TRUE(none["keyframes"]["ids"].empty());
   EXPECT_TRUE(none["trajectory_append"].empty());
   EXPECT_FALSE(none.contains("covisibility"));
+  EXPECT_FALSE(none.contains("loop_edges"));
+  EXPECT_FALSE(none.contains("trajectory"));  // the page has it: only trajectory_append is sent
+  EXPECT_EQ(none["counts"]["loop_edges"], 1);  // the counts stay whole without the graph
 }
 
 // Reads the "viewer: URL" line of a command started with popen.

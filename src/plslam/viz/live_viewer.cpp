@@ -113,19 +113,15 @@ json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, 
   json removed_lines = json::array();
   for (const auto& [id, l] : old_lines) removed_lines.push_back(id);
 
-  // The counts, camera, local map and graph as the full document has them.
-  const json full_parts = scene_document(map::MapSnapshot{0, {}, {}, {}}, info);
+  // Only what changes per update: the trajectory gains its new tail, and the graph is built only
+  // when it changed (building the whole document here cost a full serialisation per update).
   json trail = json::array();
   for (std::size_t i = trail_sent; i < info.trajectory.size(); ++i) append(trail, info.trajectory[i]);
-  json counts = full_parts["counts"];
-  counts["keyframes"] = after.keyframes.size();
-  counts["points"] = after.points.size();
-  counts["lines"] = after.lines.size();
   json d = {{"revision", revision},
             {"final", info.final},
-            {"counts", counts},
-            {"camera", full_parts["camera"]},
-            {"local_map", full_parts["local_map"]},
+            {"counts", scene_counts(after, info)},
+            {"camera", scene_camera(info)},
+            {"local_map", scene_local_map(info)},
             {"trajectory_append", trail},
             {"keyframes", keyframe_arrays(changed_kfs)},
             {"keyframes_removed", removed_kfs},
@@ -134,10 +130,9 @@ json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, 
             {"lines", {{"ids", line_ids}, {"xyz", line_xyz}}},
             {"lines_removed", removed_lines}};
   if (graph_changed) {
-    const json graph = scene_document(after, SceneInfo{});
-    d["loop_edges"] = graph["loop_edges"];
-    d["covisibility"] = graph["covisibility"];
-    d["counts"]["loop_edges"] = graph["counts"]["loop_edges"];
+    auto graph = scene_graph(after);
+    d["loop_edges"] = std::move(graph.loop_edges);
+    d["covisibility"] = std::move(graph.covisibility);
   }
   return d;
 }

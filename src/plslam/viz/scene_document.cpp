@@ -153,21 +153,54 @@ void parse_map_graph(const std::string& text, const std::string& source, map::Ma
   }
 }
 
+SceneGraph scene_graph(const map::MapSnapshot& map) {
+  SceneGraph g{json::array(), json::array()};
+  for (const auto& kf : map.keyframes) {
+    // Each edge once, from its lower id.
+    for (const long other : kf.loop_edges) {
+      if (kf.id < other) g.loop_edges.push_back({kf.id, other});
+    }
+    for (const auto& [other, weight] : kf.covisibility) {
+      if (kf.id < other) g.covisibility.push_back({kf.id, other, weight});
+    }
+  }
+  return g;
+}
+
+json scene_counts(const map::MapSnapshot& map, const SceneInfo& info) {
+  std::size_t loop_edges = 0;
+  for (const auto& kf : map.keyframes) {
+    loop_edges += static_cast<std::size_t>(std::count_if(kf.loop_edges.begin(), kf.loop_edges.end(),
+                                                         [&](long other) { return kf.id < other; }));
+  }
+  return {{"frame", optional_json(info.frame)},
+          {"frames", optional_json(info.frames)},
+          {"tracked", optional_json(info.tracked)},
+          {"keyframes", map.keyframes.size()},
+          {"points", map.points.size()},
+          {"lines", map.lines.size()},
+          {"loops", optional_json(info.loops)},
+          {"loop_edges", loop_edges},
+          {"relocalizations", optional_json(info.relocalizations)},
+          {"state", optional_json(info.state)},
+          {"fps", optional_json(info.fps)}};
+}
+
+json scene_camera(const SceneInfo& info) { return info.camera ? pose_row_major(*info.camera) : json(nullptr); }
+
+json scene_local_map(const SceneInfo& info) {
+  if (!info.local_map) return nullptr;
+  return {{"keyframes", info.local_map->first}, {"points", info.local_map->second}};
+}
+
 json scene_document(const map::MapSnapshot& map, const SceneInfo& info) {
-  json ids = json::array(), poses = json::array(), parents = json::array(), loop_edges = json::array(),
-       covisibility = json::array();
+  json ids = json::array(), poses = json::array(), parents = json::array();
   for (const auto& kf : map.keyframes) {
     ids.push_back(kf.id);
     for (auto& v : pose_row_major(kf.T_wc)) poses.push_back(std::move(v));
     parents.push_back(kf.parent);
-    // Each edge once, from its lower id.
-    for (const long other : kf.loop_edges) {
-      if (kf.id < other) loop_edges.push_back({kf.id, other});
-    }
-    for (const auto& [other, weight] : kf.covisibility) {
-      if (kf.id < other) covisibility.push_back({kf.id, other, weight});
-    }
   }
+  auto graph = scene_graph(map);
   json point_ids = json::array(), point_xyz = json::array(), line_ids = json::array(), line_xyz = json::array();
   for (const auto& p : map.points) {
     point_ids.push_back(p.id);
@@ -190,34 +223,21 @@ json scene_document(const map::MapSnapshot& map, const SceneInfo& info) {
   if (const auto& c = info.camera_model) {
     camera_model = {{"width", c->width}, {"height", c->height}, {"fx", c->fx}, {"fy", c->fy}, {"cx", c->cx}, {"cy", c->cy}};
   }
-  json local_map = nullptr;
-  if (info.local_map) local_map = {{"keyframes", info.local_map->first}, {"points", info.local_map->second}};
   return {{"version", 1},
           {"source", info.source},
           {"name", info.name},
           {"final", info.final},
           {"revision", info.revision},
-          {"counts",
-           {{"frame", optional_json(info.frame)},
-            {"frames", optional_json(info.frames)},
-            {"tracked", optional_json(info.tracked)},
-            {"keyframes", map.keyframes.size()},
-            {"points", map.points.size()},
-            {"lines", map.lines.size()},
-            {"loops", optional_json(info.loops)},
-            {"loop_edges", loop_edges.size()},
-            {"relocalizations", optional_json(info.relocalizations)},
-            {"state", optional_json(info.state)},
-            {"fps", optional_json(info.fps)}}},
+          {"counts", scene_counts(map, info)},
           {"keyframes", {{"ids", ids}, {"poses", poses}, {"parents", parents}}},
-          {"loop_edges", loop_edges},
-          {"covisibility", covisibility},
+          {"loop_edges", std::move(graph.loop_edges)},
+          {"covisibility", std::move(graph.covisibility)},
           {"trajectory", trajectory},
-          {"camera", info.camera ? pose_row_major(*info.camera) : json(nullptr)},
+          {"camera", scene_camera(info)},
           {"ground_truth", ground_truth},
           {"points", {{"ids", point_ids}, {"xyz", point_xyz}}},
           {"lines", {{"ids", line_ids}, {"xyz", line_xyz}}},
-          {"local_map", local_map},
+          {"local_map", scene_local_map(info)},
           {"camera_model", camera_model}};
 }
 

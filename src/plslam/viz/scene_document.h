@@ -37,6 +37,16 @@ struct SceneInfo {
 
 nlohmann::json scene_document(const map::MapSnapshot& map, const SceneInfo& info);
 
+// Parts of that document, for the live viewer's deltas, which must not pay for the whole.
+struct SceneGraph {
+  nlohmann::json loop_edges;    // [[a, b], ...], each edge once
+  nlohmann::json covisibility;  // [[a, b, weight], ...]
+};
+SceneGraph scene_graph(const map::MapSnapshot& map);
+nlohmann::json scene_counts(const map::MapSnapshot& map, const SceneInfo& info);
+nlohmann::json scene_camera(const SceneInfo& info);     // T_wc row-major 3x4, or null
+nlohmann::json scene_local_map(const SceneInfo& info);  // {keyframes, points}, or null
+
 struct Scene {
   map::MapSnapshot map;
   SceneInfo info;
