@@ -17,7 +17,10 @@ const material = {
   camera: new THREE.LineBasicMaterial({ color: 0xff2a2a, depthTest: false }),
   trajectory: new THREE.LineBasicMaterial({ color: 0xc77dff }),
   groundTruth: new THREE.LineBasicMaterial({ color: 0x63e67f }),
-  loops: new THREE.LineBasicMaterial({ color: 0xff7a1a }),
+  // A loop joins two keyframes that are often a few centimetres apart, inside the blue frustums:
+  // drawn over them, with a dot at each end, so that every closed loop can be found.
+  loops: new THREE.LineBasicMaterial({ color: 0xff7a1a, depthTest: false }),
+  loopEnds: new THREE.PointsMaterial({ size: 7, sizeAttenuation: false, color: 0xff7a1a, depthTest: false }),
   covisibility: new THREE.LineBasicMaterial({ color: 0x9fb0a0, transparent: true, opacity: 0.35,
                                               depthWrite: false }),
   localKeyframes: new THREE.LineBasicMaterial({ color: 0x8fe3ff }),
@@ -237,7 +240,11 @@ export class SceneLayers {
     }
     const loops = edgeSegments(doc.loop_edges ?? [], indexOfId, poses);
     if (loops.length > 0) {
-      this.add('loops', new THREE.LineSegments(geometry(loops), material.loops), loops.length / 6);
+      const edges = new THREE.LineSegments(geometry(loops), material.loops);
+      const ends = new THREE.Points(geometry(loops), material.loopEnds);
+      edges.renderOrder = ends.renderOrder = 3;
+      this.add('loops', edges, loops.length / 6);
+      this.groups.loops.add(ends);
     }
     const covisible = edgeSegments(doc.covisibility ?? [], indexOfId, poses);
     if (covisible.length > 0) {
