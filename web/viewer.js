@@ -29,10 +29,10 @@ const layers = new SceneLayers(root);
 let needsRender = true;
 const requestRender = () => { needsRender = true; };
 
-// Software renderers (no GPU: SwiftShader, some remote desktops) draw 100k points at a few
-// frames per second. Once frames of a moving view come slower than SLOW_FRAME_MS three times
+// Software renderers (no GPU: SwiftShader, some remote desktops) draw 100k points at 10-25
+// frames per second on 2 cores (bench/viewer_load.sh). Once frames of a moving view come slower than SLOW_FRAME_MS three times
 // in a row, points and lines are thinned while the view moves; the still view is always full.
-const SLOW_FRAME_MS = 50;
+const SLOW_FRAME_MS = 34;           // slower than ~30 fps (a frame every other 60 Hz vsync)
 const MOVING_MS = 200;              // the view counts as moving this long after its last change
 let lastChange = -Infinity;
 let thinWhileMoving = false;
