@@ -8,8 +8,11 @@
 #   poller   --viewer at 5 Hz with a client that follows it as the page does (deltas every 200 ms,
 #            the camera image when it changes): the server's side, as with a browser on another
 #            machine
-#   browser  --viewer at 5 Hz with the page open in headless Chromium on this same machine: adds
-#            the browser's software rendering (SwiftShader) to the two cores
+#   browser  --viewer at 5 Hz, the page opened in headless Chromium on this same machine once the
+#            run prints its URL: the browser's launch, page load and software rendering
+#            (SwiftShader) share the two cores with the run
+#   open     as browser, but Chromium is launched and waiting before the run starts (a page left
+#            open on the robot's own screen): the steady cost of the page's updates and renders
 # Default dataset: the office loop (480 frames, seed 1), rendered into OUT/office when missing.
 # OUT/summary.txt has one line per mode: the runs' medians and the ratio to `off`.
 set -euo pipefail
@@ -58,11 +61,29 @@ browser() {
   node bench/viewer_follow.mjs "$1"
 }
 
+free_port() {
+  python3 -c "import socket; s = socket.socket(); s.bind(('127.0.0.1', 0)); print(s.getsockname()[1])"
+}
+
 run_one() {  # mode, index
   local mode=$1 i=$2 dir="$out/$1-$2"
   rm -rf "$dir"
   if [ "$mode" = off ]; then
     "$plslam" run "$dataset" --out "$dir" --quiet >/dev/null 2>&1
+  elif [ "$mode" = open ]; then
+    local port
+    port=$(free_port)
+    node bench/viewer_follow.mjs "http://127.0.0.1:$port/" --before >"$dir.browser" 2>&1 &
+    local browser_pid=$!
+    for _ in $(seq 300); do
+      grep -q "browser ready" "$dir.browser" 2>/dev/null && break
+      sleep 0.1
+    done
+    "$plslam" run "$dataset" --out "$dir" --quiet --viewer --port "$port" --viewer-linger 5 >/dev/null 2>&1 &
+    local pid=$!
+    wait "$browser_pid" || true
+    kill -TERM "$pid" 2>/dev/null || true
+    wait "$pid" || true
   else
     "$plslam" run "$dataset" --out "$dir" --quiet --viewer --port 0 --viewer-linger 5 >"$dir.stdout" 2>/dev/null &
     local pid=$! url=""
@@ -78,9 +99,9 @@ run_one() {  # mode, index
   python3 -c "import json; print(json.load(open('$dir/stats.json'))['tracking_ms']['median'])" >> "$out/$mode.txt"
 }
 
-rm -f "$out"/{off,poller,browser}.txt
+rm -f "$out"/{off,poller,browser,open}.txt
 for i in $(seq "$runs"); do
-  for mode in off poller browser; do
+  for mode in off poller browser open; do
     run_one "$mode" "$i"
     echo "run $i $mode: $(tail -1 "$out/$mode.txt") ms"
   done
@@ -88,8 +109,8 @@ done
 python3 - "$out" <<'PY' | tee "$out/summary.txt"
 import statistics, sys
 out = sys.argv[1]
-med = {m: statistics.median(float(x) for x in open(f"{out}/{m}.txt")) for m in ("off", "poller", "browser")}
-for m in ("off", "poller", "browser"):
+med = {m: statistics.median(float(x) for x in open(f"{out}/{m}.txt")) for m in ("off", "poller", "browser", "open")}
+for m in ("off", "poller", "browser", "open"):
     runs = " ".join(f"{float(x):.1f}" for x in open(f"{out}/{m}.txt"))
     print(f"{m:8s} median {med[m]:.2f} ms/frame (runs: {runs}), ratio to off {med[m] / med['off']:.3f}")
 PY
