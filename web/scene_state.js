@@ -24,6 +24,8 @@ export class SceneState {
     kf.ids.forEach((id, i) => this.keyframes.set(id, { pose: kf.poses.slice(12 * i, 12 * i + 12), parent: kf.parents[i] }));
     upsert(this.points, delta.points, delta.points_removed, 3);
     upsert(this.lines, delta.lines, delta.lines_removed, 6);
+    // The whole trajectory when a loop correction or a global BA moved what the page had.
+    if (delta.trajectory !== undefined) this.trajectory = Array.from(delta.trajectory);
     for (const v of delta.trajectory_append ?? []) this.trajectory.push(v);
   }
 

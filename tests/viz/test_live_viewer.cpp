@@ -83,6 +83,44 @@ TEST(SceneDelta, HoldsWhatWasAddedMovedAndRemovedAndNothingElse) {
   EXPECT_FALSE(none.contains("loop_edges"));
   EXPECT_FALSE(none.contains("trajectory"));  // the page has it: only trajectory_append is sent
   EXPECT_EQ(none["counts"]["loop_edges"], 1);  // the counts stay whole without the graph
+  // No count of what the page has: the whole trajectory, replacing the page's.
+  const json whole = scene_delta(after, after, info, std::nullopt, 7);
+  EXPECT_EQ(whole["trajectory"].size(), 9u);
+  EXPECT_FALSE(whole.contains("trajectory_append"));
+}
+
+// Centres move with their keyframes; the page gets the new tail, or the whole trail once a centre
+// it has moved by more than the threshold (a loop correction), and never for local BA's millimetres.
+TEST(LiveTrail, CentresFollowTheirKeyframesAndAreResentOnlyWhenTheyMovedFar) {
+  auto map = two_keyframes();  // keyframe 0 at x = 0, keyframe 1 at x = 1
+  LiveTrail trail(0.02);
+  trail.add(0, {0, 0, 0.5}, {0, 0, 0.5});
+  trail.add(1, {0, 0, 0.5}, {1, 0, 0.5});
+  trail.add(9, {0, 0, 0}, {5, 5, 5});  // a keyframe not in the snapshot: stays in place
+  EXPECT_FALSE(trail.update(map));
+  trail.sent(false);
+  EXPECT_EQ(trail.page_size(), 3u);
+  EXPECT_TRUE(trail.centres()[1].isApprox(Eigen::Vector3d(1, 0, 0.5)));
+
+  // Local BA: keyframe 1 moves 5 mm. The centre follows, nothing is resent.
+  map.keyframes[1].T_wc = geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1.005, 0, 0));
+  trail.add(1, {0, 0, 1}, {1.005, 0, 1});
+  EXPECT_FALSE(trail.update(map));
+  EXPECT_NEAR(trail.centres()[1].x(), 1.005, 1e-12);
+  trail.sent(false);
+  EXPECT_EQ(trail.page_size(), 4u);
+
+  // A loop correction turns keyframe 1 by 90 degrees about y and moves it back 0.3 m.
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  map.keyframes[1].T_wc = geometry::SE3(R, Eigen::Vector3d(0.7, 0, 0));
+  EXPECT_TRUE(trail.update(map));
+  EXPECT_TRUE(trail.centres()[1].isApprox(Eigen::Vector3d(0.7 + 0.5, 0, 0), 1e-12));  // R * (0, 0, 0.5) = (0.5, 0, 0)
+  EXPECT_TRUE(trail.centres()[3].isApprox(Eigen::Vector3d(1.7, 0, 0), 1e-12));
+  EXPECT_TRUE(trail.centres()[0].isApprox(Eigen::Vector3d(0, 0, 0.5)));
+  EXPECT_TRUE(trail.centres()[2].isApprox(Eigen::Vector3d(5, 5, 5)));
+  trail.sent(true);
+  EXPECT_EQ(trail.page_size(), 4u);
+  EXPECT_FALSE(trail.update(map));  // the page has them now
 }
 
 // Reads the "viewer: URL" line of a command started with popen.

@@ -232,7 +232,12 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
       v.state = tracking::to_string(r.track.state);
       v.tracked = r.track.tracked;
       if (r.track.tracked && !slam.tracker().records().empty()) {
-        v.T_wc = tracking::Tracker::pose_of(slam.tracker().records().back()).inverse();
+        const auto anchor = tracking::Tracker::anchor_of(slam.tracker().records().back());
+        v.T_wc = (anchor.keyframe ? anchor.T_ck * anchor.keyframe->pose() : anchor.T_ck).inverse();
+        if (anchor.keyframe) {
+          v.anchor_keyframe = anchor.keyframe->id();
+          v.centre_in_anchor = anchor.T_ck.inverse().translation();
+        }
       }
       v.loops = slam.loop_closer() ? static_cast<long>(slam.loop_closer()->stats().loops.size()) : 0;
       v.relocalizations = static_cast<long>(slam.tracker().relocalized_frames().size());

@@ -84,7 +84,7 @@ Tracker::TrackedFeatures Tracker::last_tracked_features() const {
   return out;
 }
 
-geometry::SE3 Tracker::pose_of(const FrameRecord& r) {
+Tracker::Anchor Tracker::anchor_of(const FrameRecord& r) {
   geometry::SE3 T_cr = r.T_cr;
   map::KeyFrame* ref = r.reference;
   // Culled keyframes hand their frames over to their parents.
@@ -92,7 +92,12 @@ geometry::SE3 Tracker::pose_of(const FrameRecord& r) {
     T_cr = T_cr * ref->pose_relative_to_parent();
     ref = ref->parent();
   }
-  return ref ? T_cr * ref->pose() : T_cr;
+  return {ref, T_cr};
+}
+
+geometry::SE3 Tracker::pose_of(const FrameRecord& r) {
+  const auto a = anchor_of(r);
+  return a.keyframe ? a.T_ck * a.keyframe->pose() : a.T_ck;
 }
 
 void Tracker::check_motion(const Frame& f) {

@@ -181,6 +181,13 @@ class Tracker {
   TrackedFeatures last_tracked_features() const;
   // The pose of a record with every keyframe's current estimate (call with local mapping idle).
   static geometry::SE3 pose_of(const FrameRecord& r);
+  // The keyframe a record's pose hangs on (its reference, or the first live ancestor of a culled
+  // one) and the frame's pose relative to it; nullptr and T_cr for a record without one.
+  struct Anchor {
+    const map::KeyFrame* keyframe = nullptr;
+    geometry::SE3 T_ck;
+  };
+  static Anchor anchor_of(const FrameRecord& r);
 
  private:
   bool initialize(Frame& f);

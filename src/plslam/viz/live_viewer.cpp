@@ -60,8 +60,32 @@ void LiveViewerOptions::validate() const {
   if (!(rate_hz > 0 && rate_hz <= 60)) throw InputError("", fmt::format("viewer rate {} Hz: must be in (0, 60]", rate_hz));
 }
 
+void LiveTrail::add(long keyframe, const Eigen::Vector3d& centre_in_keyframe, const Eigen::Vector3d& centre_world) {
+  anchors_.push_back({keyframe, centre_in_keyframe});
+  centres_.push_back(centre_world);
+}
+
+bool LiveTrail::update(const map::MapSnapshot& map) {
+  std::unordered_map<long, const geometry::SE3*> pose_of;
+  pose_of.reserve(map.keyframes.size());
+  for (const auto& kf : map.keyframes) pose_of.emplace(kf.id, &kf.T_wc);
+  bool resend = false;
+  for (std::size_t i = 0; i < anchors_.size(); ++i) {
+    const auto it = pose_of.find(anchors_[i].keyframe);
+    if (it == pose_of.end()) continue;  // culled since, or not in the map yet: stays where it was
+    centres_[i] = *it->second * anchors_[i].in_keyframe;
+    if (i < page_.size() && (centres_[i] - page_[i]).norm() > resend_move_m_) resend = true;
+  }
+  return resend;
+}
+
+void LiveTrail::sent(bool whole) {
+  if (whole) page_.clear();
+  page_.insert(page_.end(), centres_.begin() + static_cast<std::ptrdiff_t>(page_.size()), centres_.end());
+}
+
 json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, const SceneInfo& info,
-                 std::size_t trail_sent, long revision, double min_move_m) {
+                 std::optional<std::size_t> trail_sent, long revision, double min_move_m) {
   // Keyframes: upserted when new or moved; the graph is resent whole when any keyframe changed
   // (a few thousand edges at most).
   std::unordered_map<long, const map::KeyframeSnapshot*> old_kfs;
@@ -116,13 +140,13 @@ json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, 
   // Only what changes per update: the trajectory gains its new tail, and the graph is built only
   // when it changed (building the whole document here cost a full serialisation per update).
   json trail = json::array();
-  for (std::size_t i = trail_sent; i < info.trajectory.size(); ++i) append(trail, info.trajectory[i]);
+  for (std::size_t i = trail_sent.value_or(0); i < info.trajectory.size(); ++i) append(trail, info.trajectory[i]);
   json d = {{"revision", revision},
             {"final", info.final},
             {"counts", scene_counts(after, info)},
             {"camera", scene_camera(info)},
             {"local_map", scene_local_map(info)},
-            {"trajectory_append", trail},
+            {trail_sent ? "trajectory_append" : "trajectory", trail},
             {"keyframes", keyframe_arrays(changed_kfs)},
             {"keyframes_removed", removed_kfs},
             {"points", {{"ids", point_ids}, {"xyz", point_xyz}}},
@@ -194,7 +218,7 @@ void LiveViewer::publish_once() {
   auto& info = scene->info;
   info = base_;
   if (frame) {
-    if (frame->tracked) trail_.push_back(frame->T_wc.translation());
+    if (frame->tracked) trail_.add(frame->anchor_keyframe, frame->centre_in_anchor, frame->T_wc.translation());
     info.frame = frame->frame;
     info.frames = frame->frames;
     info.tracked = frame->tracked_frames;
@@ -205,13 +229,16 @@ void LiveViewer::publish_once() {
     if (frame->tracked) info.camera = frame->T_wc;
     info.local_map = std::make_pair(frame->local_keyframes, frame->local_points);
   }
-  info.trajectory = trail_;
+  const bool resend_trail = trail_.update(scene->map);
+  info.trajectory = trail_.centres();
   // The camera image at half the update rate: encoding costs a few ms of this thread.
   if (frame && !frame->left.empty() && image_updates_++ % 2 == 0) server_.publish_image(annotated_jpeg(*frame));
   const long revision = revision_.load() + 1;
   info.revision = revision;
-  const auto delta = scene_delta(last_->map, scene->map, info, trail_sent_, revision).dump();
-  trail_sent_ = trail_.size();
+  const auto delta =
+      scene_delta(last_->map, scene->map, info, resend_trail ? std::nullopt : std::optional(trail_.page_size()), revision)
+          .dump();
+  trail_.sent(resend_trail);
   last_ = scene;
   server_.publish(revision, [scene] { return scene_document(scene->map, scene->info).dump(); }, delta);
   revision_.store(revision);

@@ -32,6 +32,10 @@ struct LiveFrame {
   std::string state;  // tracking state
   bool tracked = false;
   geometry::SE3 T_wc;
+  // The keyframe the pose hangs on (-1: none) and the camera centre in its frame: the trail moves
+  // with that keyframe when local BA, a loop correction or a global BA moves it.
+  long anchor_keyframe = -1;
+  Eigen::Vector3d centre_in_anchor = Eigen::Vector3d::Zero();
   long loops = 0, relocalizations = 0, frames = 0, tracked_frames = 0;
   double fps = 0;
   std::vector<long> local_keyframes, local_points;
@@ -40,6 +44,33 @@ struct LiveFrame {
   cv::Mat left;
   std::vector<cv::Point2f> tracked_points;
   std::vector<std::pair<cv::Point2f, cv::Point2f>> tracked_lines;
+};
+
+// The live trajectory as the page draws it. Each tracked centre hangs on its anchor keyframe and
+// is moved with that keyframe's pose in each snapshot; a centre whose keyframe is gone keeps its
+// place. The page has the centres up to page_size(): only the new tail goes out, unless a centre
+// it has moved by more than `resend_move_m` (a loop correction, a global BA; local BA's
+// millimetres are not worth resending a long trail five times a second).
+class LiveTrail {
+ public:
+  explicit LiveTrail(double resend_move_m = 0.01) : resend_move_m_(resend_move_m) {}
+  void add(long keyframe, const Eigen::Vector3d& centre_in_keyframe, const Eigen::Vector3d& centre_world);
+  // Moves every centre with its keyframe; true when the page must get the whole trail again.
+  bool update(const map::MapSnapshot& map);
+  // The page now has every centre (`whole`: resent; else: the tail after page_size() appended).
+  void sent(bool whole);
+  const std::vector<Eigen::Vector3d>& centres() const { return centres_; }
+  std::size_t page_size() const { return page_.size(); }
+
+ private:
+  struct Anchor {
+    long keyframe;
+    Eigen::Vector3d in_keyframe;
+  };
+  double resend_move_m_;
+  std::vector<Anchor> anchors_;
+  std::vector<Eigen::Vector3d> centres_;  // world, as of the last update
+  std::vector<Eigen::Vector3d> page_;     // world, as the page has them
 };
 
 struct LiveViewerOptions {
@@ -81,11 +112,10 @@ class LiveViewer {
   std::mutex frame_mutex_;  // guards frame_, new_frame_
   std::optional<LiveFrame> frame_;
   bool new_frame_ = false;
-  std::vector<Eigen::Vector3d> trail_;  // tracked camera centres, publisher thread only
+  LiveTrail trail_;  // publisher thread only
 
   // Publisher thread state.
   std::shared_ptr<const Scene> last_;  // the state of the last revision
-  std::size_t trail_sent_ = 0;
   long image_updates_ = 0;
   long last_changes_ = -1;
   std::atomic<long> revision_{0};
@@ -98,8 +128,10 @@ class LiveViewer {
 
 // The change from `before` to `after` as the page applies it: upserted and removed keyframes,
 // points and lines (a landmark counts as changed when it moved by more than `min_move_m`), the
-// graph, counts, camera, local map and the trajectory points after the first `trail_sent`.
+// graph, counts, camera, local map, and of the trajectory the points after the first
+// `trail_sent` ("trajectory_append"), or all of it ("trajectory", replacing the page's) when
+// `trail_sent` is empty.
 nlohmann::json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, const SceneInfo& info,
-                           std::size_t trail_sent, long revision, double min_move_m = 1e-3);
+                           std::optional<std::size_t> trail_sent, long revision, double min_move_m = 1e-3);
 
 }  // namespace plslam::viz
