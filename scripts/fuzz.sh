@@ -5,7 +5,8 @@
 #   scripts/fuzz.sh [--minutes N | --seconds S] [target...]   default: 5 minutes each, every target
 #
 # Targets (tests/fuzz/targets): config trajectory euroc_sensor euroc_data_csv euroc_groundtruth
-# kitti_calib kitti_times frame_log image vocabulary bench_configs map_file calibration_file. Each starts from tests/fuzz/corpus/<target>/ (the
+# kitti_calib kitti_times frame_log image vocabulary bench_configs map_file calibration_file
+# run_folder. Each starts from tests/fuzz/corpus/<target>/ (the
 # checked-in seeds) and keeps what it learns in build-fuzz/corpus/<target>/; crashes are written
 # to build-fuzz/crashes/<target>/. A crash input belongs in tests/fuzz/corpus/<target>/ once the
 # bug is fixed: the ctest FuzzReplay.* replays every corpus file in every build.
@@ -19,7 +20,7 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --minutes) minutes="${2:?--minutes needs a number}"; shift 2 ;;
     --seconds) seconds="${2:?--seconds needs a number}"; shift 2 ;;
-    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) targets+=("$1"); shift ;;
   esac
 done

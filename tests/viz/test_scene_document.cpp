@@ -169,6 +169,30 @@ TEST(SceneDocument, ABrokenRunFolderIsAnInputErrorNamingTheFile) {
   EXPECT_THROW(scene_from_run_folder("/no/such/folder"), InputError);
 }
 
+TEST(SceneDocument, StatsWithAnImpossibleCalibrationAreAnInputError) {
+  const std::string head = R"({"frames": 3, "input": {"calibration": {"width": )";
+  const std::string tail = R"(, "height": 480, "fx": 400, "fy": 400, "cx": 320, "cy": 240, "baseline": 0.1}}})";
+  SceneInfo info;
+  parse_run_stats(head + "640" + tail, "stats.json", info);
+  ASSERT_TRUE(info.camera_model.has_value());
+  EXPECT_EQ(info.camera_model->width, 640);
+  EXPECT_EQ(info.frame, 2);
+  // 1e20 is a float out of int's range (undefined behaviour in a plain get<int>), -640 and 6.5
+  // are no image sizes.
+  for (const std::string width : {"1e20", "-640", "6.5", "\"640\"", "null"}) {
+    SceneInfo bad;
+    try {
+      parse_run_stats(head + width + tail, "stats.json", bad);
+      FAIL() << width;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("stats.json: input.calibration.width"), std::string::npos) << e.what();
+    }
+  }
+  SceneInfo nan_fx;
+  EXPECT_THROW(parse_run_stats(R"({"input": {"calibration": {"width": 640, "height": 480, "fx": "x"}}})", "s", nan_fx),
+               InputError);
+}
+
 TEST(SceneDocument, TheMapGraphReadsBackAsWritten) {
   RunFolder run;
   map::MapSnapshot back;

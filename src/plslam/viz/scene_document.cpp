@@ -1,6 +1,7 @@
 #include "plslam/viz/scene_document.h"
 
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 #include <set>
 
@@ -46,18 +47,10 @@ std::string read_text(const fs::path& path) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-json parse_json_file(const fs::path& path) {
-  try {
-    return json::parse(read_text(path));
-  } catch (const json::exception& e) {
-    throw InputError(path.string(), std::string("not JSON: ") + e.what());
-  }
-}
-
 // A whole number from stats.json, or nullopt when the key is absent or null.
-std::optional<long> optional_count(const json& j, const char* key, const fs::path& file) {
+std::optional<long> optional_count(const json& j, const char* key, const std::string& file) {
   if (!j.contains(key) || j[key].is_null()) return std::nullopt;
-  if (!j[key].is_number_integer()) throw InputError(file.string(), fmt::format("'{}' is not a whole number", key));
+  if (!j[key].is_number_integer()) throw InputError(file, fmt::format("'{}' is not a whole number", key));
   return j[key].get<long>();
 }
 
@@ -241,6 +234,53 @@ json scene_document(const map::MapSnapshot& map, const SceneInfo& info) {
           {"camera_model", camera_model}};
 }
 
+json parse_run_stats(const std::string& text, const std::string& source, SceneInfo& info) {
+  json stats;
+  try {
+    stats = json::parse(text);
+  } catch (const json::exception& e) {
+    throw InputError(source, std::string("not JSON: ") + e.what());
+  }
+  if (!stats.is_object()) throw InputError(source, "not a JSON object");
+  info.frames = optional_count(stats, "frames", source);
+  info.tracked = optional_count(stats, "tracked_frames", source);
+  if (info.frames && *info.frames > 0) info.frame = *info.frames - 1;
+  if (stats.contains("loops") && stats["loops"].is_array()) info.loops = static_cast<long>(stats["loops"].size());
+  if (stats.contains("relocalizations") && stats["relocalizations"].is_object()) {
+    info.relocalizations = optional_count(stats["relocalizations"], "count", source);
+  }
+  const bool interrupted = stats.contains("interrupted_by") && !stats["interrupted_by"].is_null();
+  const bool complete = stats.contains("complete") && stats["complete"] == true;
+  info.state = interrupted ? "interrupted" : complete ? "finished" : "incomplete";
+  if (stats.contains("input") && stats["input"].is_object() && stats["input"].contains("calibration")) {
+    const auto& c = stats["input"]["calibration"];
+    // Checked before get<>: a float out of int's range would be undefined behaviour there.
+    auto size = [&](const char* key) {
+      if (!c.is_object() || !c.contains(key) || !c[key].is_number_integer() || c[key].get<long long>() <= 0 ||
+          c[key].get<long long>() > 100000) {
+        throw InputError(source, fmt::format("input.calibration.{}: not a whole number in 1..100000", key));
+      }
+      return static_cast<int>(c[key].get<long long>());
+    };
+    auto number = [&](const char* key) {
+      if (!c.contains(key) || !c[key].is_number() || !std::isfinite(c[key].get<double>())) {
+        throw InputError(source, fmt::format("input.calibration.{}: not a finite number", key));
+      }
+      return c[key].get<double>();
+    };
+    StereoCalibration calib;
+    calib.width = size("width");
+    calib.height = size("height");
+    calib.fx = number("fx");
+    calib.fy = number("fy");
+    calib.cx = number("cx");
+    calib.cy = number("cy");
+    calib.baseline = number("baseline");
+    info.camera_model = calib;
+  }
+  return stats;
+}
+
 Scene scene_from_run_folder(const fs::path& folder) {
   std::error_code ec;
   if (!fs::is_directory(folder, ec)) throw InputError(folder.string(), "not a folder");
@@ -249,18 +289,7 @@ Scene scene_from_run_folder(const fs::path& folder) {
   info.source = "run";
   info.name = folder.string();
   const auto stats_path = folder / "stats.json";
-  const json stats = parse_json_file(stats_path);
-  if (!stats.is_object()) throw InputError(stats_path.string(), "not a JSON object");
-  info.frames = optional_count(stats, "frames", stats_path);
-  info.tracked = optional_count(stats, "tracked_frames", stats_path);
-  if (info.frames && *info.frames > 0) info.frame = *info.frames - 1;
-  if (stats.contains("loops") && stats["loops"].is_array()) info.loops = static_cast<long>(stats["loops"].size());
-  if (stats.contains("relocalizations") && stats["relocalizations"].is_object()) {
-    info.relocalizations = optional_count(stats["relocalizations"], "count", stats_path);
-  }
-  const bool interrupted = stats.contains("interrupted_by") && !stats["interrupted_by"].is_null();
-  const bool complete = stats.contains("complete") && stats["complete"] == true;
-  info.state = interrupted ? "interrupted" : complete ? "finished" : "incomplete";
+  const json stats = parse_run_stats(read_text(stats_path), stats_path.string(), info);
 
   const auto trajectory = io::read_trajectory(folder / "trajectory.tum", io::TrajectoryFormat::kTum);
   for (const auto& p : trajectory) info.trajectory.push_back(p.T.translation());
@@ -285,22 +314,6 @@ Scene scene_from_run_folder(const fs::path& folder) {
   const auto lines = io::read_ply_lines(folder / "map_lines.ply");
   for (std::size_t i = 0; i < lines.size(); ++i) {
     scene.map.lines.push_back({static_cast<long>(i), lines[i].first, lines[i].second});
-  }
-  if (stats.contains("input") && stats["input"].is_object() && stats["input"].contains("calibration")) {
-    const auto& c = stats["input"]["calibration"];
-    try {
-      StereoCalibration calib;
-      calib.width = c.at("width").get<int>();
-      calib.height = c.at("height").get<int>();
-      calib.fx = c.at("fx").get<double>();
-      calib.fy = c.at("fy").get<double>();
-      calib.cx = c.at("cx").get<double>();
-      calib.cy = c.at("cy").get<double>();
-      calib.baseline = c.at("baseline").get<double>();
-      info.camera_model = calib;
-    } catch (const json::exception& e) {
-      throw InputError(stats_path.string(), std::string("input.calibration: ") + e.what());
-    }
   }
   add_ground_truth(stats, info, trajectory);
   return scene;

@@ -62,6 +62,10 @@ Scene scene_from_run_folder(const std::filesystem::path& folder);
 // stand for the trajectory. InputError for a bad file.
 Scene scene_from_map_file(const std::filesystem::path& file);
 
+// The panel's counts, state and camera model from the text of a run's stats.json (`source` names
+// it in errors); returns the parsed document. InputError for anything malformed.
+nlohmann::json parse_run_stats(const std::string& text, const std::string& source, SceneInfo& info);
+
 // map_graph.json, as `plslam run` writes it and scene_from_run_folder reads it: every keyframe
 // with its time, pose (T_wc), spanning-tree parent, loop edges and covisibility weights.
 nlohmann::json map_graph_json(const map::MapSnapshot& map);
