@@ -213,5 +213,37 @@ TEST(SceneDocument, TheMapGraphReadsBackAsWritten) {
                InputError);
 }
 
+// Numbers that parse as JSON but are no ids or weights: a float out of long's range (30 digits:
+// undefined behaviour in a plain get<long>, found by fuzz_run_folder), a fraction, a negative
+// weight, a number where an array belongs.
+TEST(SceneDocument, TheMapGraphRefusesIdsAndWeightsThatAreNoWholeNumbers) {
+  const std::string ok_id = R"("id": 1, "parent": -1)";
+  const auto graph = [](const std::string& fields) {
+    return R"({"version": 1, "keyframes": [{)" + fields +
+           R"(, "t": 0, "T_wc": [1,0,0,0, 0,1,0,0, 0,0,1,0]}]})";
+  };
+  map::MapSnapshot good;
+  parse_map_graph(graph(ok_id + R"(, "loop_edges": [2], "covisibility": [[2, 40]])"), "g", good);
+  ASSERT_EQ(good.keyframes.size(), 1u);
+  EXPECT_EQ(good.keyframes[0].covisibility, (std::vector<std::pair<long, int>>{{2, 40}}));
+  for (const std::string bad :
+       {R"("id": 222222222222222222222222222222, "parent": -1, "loop_edges": [], "covisibility": [])",
+        R"("id": 1.5, "parent": -1, "loop_edges": [], "covisibility": [])",
+        R"("id": 18446744073709551615, "parent": -1, "loop_edges": [], "covisibility": [])",
+        R"("id": 1, "parent": -1, "loop_edges": [1e300], "covisibility": [])",
+        R"("id": 1, "parent": -1, "loop_edges": 5, "covisibility": [])",
+        R"("id": 1, "parent": -1, "loop_edges": [], "covisibility": [[2, -3]])",
+        R"("id": 1, "parent": -1, "loop_edges": [], "covisibility": [[2, 1e10]])",
+        R"("id": 1, "parent": -1, "loop_edges": [], "covisibility": [2, 40])"}) {
+    map::MapSnapshot m;
+    try {
+      parse_map_graph(graph(bad), "map_graph.json", m);
+      ADD_FAILURE() << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("map_graph.json: keyframe 0"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace plslam::viz

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <iterator>
+#include <limits>
 #include <set>
 
 #include <fmt/format.h>
@@ -120,10 +122,19 @@ void parse_map_graph(const std::string& text, const std::string& source, map::Ma
     const auto& k = j["keyframes"][i];
     if (!k.is_object()) throw fail(i, "not an object");
     map::KeyframeSnapshot kf;
+    // Whole numbers are checked before get<long>: a float out of long's range (an id of 30
+    // digits parses as one) would be undefined behaviour there.
+    auto whole = [&](const json& v, const char* what) {
+      if (!v.is_number_integer() ||
+          (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<long>::max()))) {
+        throw fail(i, fmt::format("{} is not a whole number in range", what));
+      }
+      return v.get<long>();
+    };
     try {
-      kf.id = k.at("id").get<long>();
+      kf.id = whole(k.at("id"), "id");
       kf.timestamp = k.at("t").get<double>();
-      kf.parent = k.at("parent").get<long>();
+      kf.parent = whole(k.at("parent"), "parent");
       const auto T = k.at("T_wc").get<std::vector<double>>();
       if (T.size() != 12) throw fail(i, "T_wc must hold 12 numbers");
       Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
@@ -132,11 +143,15 @@ void parse_map_graph(const std::string& text, const std::string& source, map::Ma
       }
       if (!M.allFinite()) throw fail(i, "T_wc is not finite");
       kf.T_wc = geometry::SE3::from_matrix(M);
-      kf.loop_edges = k.at("loop_edges").get<std::vector<long>>();
+      if (!k.at("loop_edges").is_array() || !k.at("covisibility").is_array()) {
+        throw fail(i, "loop_edges and covisibility must be arrays");
+      }
+      for (const auto& e : k.at("loop_edges")) kf.loop_edges.push_back(whole(e, "a loop edge"));
       for (const auto& e : k.at("covisibility")) {
-        const auto pair = e.get<std::vector<long>>();
-        if (pair.size() != 2) throw fail(i, "a covisibility entry is [keyframe id, weight]");
-        kf.covisibility.emplace_back(pair[0], static_cast<int>(pair[1]));
+        if (!e.is_array() || e.size() != 2) throw fail(i, "a covisibility entry is [keyframe id, weight]");
+        const long weight = whole(e[1], "a covisibility weight");
+        if (weight < 0 || weight > std::numeric_limits<int>::max()) throw fail(i, "a covisibility weight is out of range");
+        kf.covisibility.emplace_back(whole(e[0], "a covisibility id"), static_cast<int>(weight));
       }
     } catch (const json::exception& e) {
       throw fail(i, e.what());
