@@ -233,7 +233,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
       v.tracked = r.track.tracked;
       if (r.track.tracked && !slam.tracker().records().empty()) {
         const auto anchor = tracking::Tracker::anchor_of(slam.tracker().records().back());
-        v.T_wc = (anchor.keyframe ? anchor.T_ck * anchor.keyframe->pose() : anchor.T_ck).inverse();
+        v.T_wc = anchor.T_cw().inverse();
         if (anchor.keyframe) {
           v.anchor_keyframe = anchor.keyframe->id();
           v.centre_in_anchor = anchor.T_ck.inverse().translation();

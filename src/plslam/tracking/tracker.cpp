@@ -95,10 +95,9 @@ Tracker::Anchor Tracker::anchor_of(const FrameRecord& r) {
   return {ref, T_cr};
 }
 
-geometry::SE3 Tracker::pose_of(const FrameRecord& r) {
-  const auto a = anchor_of(r);
-  return a.keyframe ? a.T_ck * a.keyframe->pose() : a.T_ck;
-}
+geometry::SE3 Tracker::Anchor::T_cw() const { return keyframe ? T_ck * keyframe->pose() : T_ck; }
+
+geometry::SE3 Tracker::pose_of(const FrameRecord& r) { return anchor_of(r).T_cw(); }
 
 void Tracker::check_motion(const Frame& f) {
   const geometry::SE3 predicted = predicted_pose(f);

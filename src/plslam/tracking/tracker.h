@@ -186,6 +186,7 @@ class Tracker {
   struct Anchor {
     const map::KeyFrame* keyframe = nullptr;
     geometry::SE3 T_ck;
+    geometry::SE3 T_cw() const;  // with the keyframe's current pose
   };
   static Anchor anchor_of(const FrameRecord& r);
 

@@ -49,11 +49,23 @@ std::string read_text(const fs::path& path) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
+// `v` as a long when it is a JSON whole number in long's range, else nullopt. Every whole number
+// read here goes through it: get<long>() of a float out of range (an id of 30 digits parses as
+// one) is undefined behaviour, and of an unsigned above long's range a wrap-around.
+std::optional<long> whole_number(const json& v) {
+  if (!v.is_number_integer()) return std::nullopt;
+  if (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<long>::max())) {
+    return std::nullopt;
+  }
+  return v.get<long>();
+}
+
 // A whole number from stats.json, or nullopt when the key is absent or null.
 std::optional<long> optional_count(const json& j, const char* key, const std::string& file) {
   if (!j.contains(key) || j[key].is_null()) return std::nullopt;
-  if (!j[key].is_number_integer()) throw InputError(file, fmt::format("'{}' is not a whole number", key));
-  return j[key].get<long>();
+  const auto n = whole_number(j[key]);
+  if (!n) throw InputError(file, fmt::format("'{}' is not a whole number", key));
+  return n;
 }
 
 // The dataset's ground truth, paired with the run's poses by time and brought into the map's
@@ -122,14 +134,10 @@ void parse_map_graph(const std::string& text, const std::string& source, map::Ma
     const auto& k = j["keyframes"][i];
     if (!k.is_object()) throw fail(i, "not an object");
     map::KeyframeSnapshot kf;
-    // Whole numbers are checked before get<long>: a float out of long's range (an id of 30
-    // digits parses as one) would be undefined behaviour there.
     auto whole = [&](const json& v, const char* what) {
-      if (!v.is_number_integer() ||
-          (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<long>::max()))) {
-        throw fail(i, fmt::format("{} is not a whole number in range", what));
-      }
-      return v.get<long>();
+      const auto n = whole_number(v);
+      if (!n) throw fail(i, fmt::format("{} is not a whole number in range", what));
+      return *n;
     };
     try {
       kf.id = whole(k.at("id"), "id");
@@ -269,13 +277,13 @@ json parse_run_stats(const std::string& text, const std::string& source, SceneIn
   info.state = interrupted ? "interrupted" : complete ? "finished" : "incomplete";
   if (stats.contains("input") && stats["input"].is_object() && stats["input"].contains("calibration")) {
     const auto& c = stats["input"]["calibration"];
-    // Checked before get<>: a float out of int's range would be undefined behaviour there.
+    if (!c.is_object()) throw InputError(source, "input.calibration: not a JSON object");
     auto size = [&](const char* key) {
-      if (!c.is_object() || !c.contains(key) || !c[key].is_number_integer() || c[key].get<long long>() <= 0 ||
-          c[key].get<long long>() > 100000) {
+      const auto n = c.contains(key) ? whole_number(c[key]) : std::nullopt;
+      if (!n || *n <= 0 || *n > 100000) {
         throw InputError(source, fmt::format("input.calibration.{}: not a whole number in 1..100000", key));
       }
-      return static_cast<int>(c[key].get<long long>());
+      return static_cast<int>(*n);
     };
     auto number = [&](const char* key) {
       if (!c.contains(key) || !c[key].is_number() || !std::isfinite(c[key].get<double>())) {
