@@ -25,9 +25,17 @@ controls.dampingFactor = 0.15;
 const views = new CameraViews(camera, controls);
 const layers = new SceneLayers(root);
 
-// Render only when something changed: a still map costs nothing.
+// Render only when something changed, and ask for animation frames only then: a page that
+// requests a frame on every vsync keeps the browser's compositor (and, without a GPU, its
+// software renderer) busy 60 times a second even when it draws nothing.
 let needsRender = true;
-const requestRender = () => { needsRender = true; };
+let frameRequested = false;
+function scheduleFrame() {
+  if (frameRequested) return;
+  frameRequested = true;
+  requestAnimationFrame(animate);
+}
+const requestRender = () => { needsRender = true; scheduleFrame(); };
 
 // Software renderers (no GPU: SwiftShader, some remote desktops) draw 100k points at 10-25
 // frames per second on 2 cores (bench/viewer_load.sh). Once frames of a moving view come slower than SLOW_FRAME_MS three times
@@ -39,6 +47,7 @@ let thinWhileMoving = false;
 let slowFrames = 0;
 let previousFrame = null;           // time of the previous animation frame, if it rendered
 controls.addEventListener('change', () => { lastChange = performance.now(); requestRender(); });
+controls.addEventListener('start', scheduleFrame);   // a drag or a wheel turn begins
 
 function render(coarse = false) {
   layers.setCoarse(coarse);
@@ -48,7 +57,8 @@ function render(coarse = false) {
 }
 
 function animate(now) {
-  controls.update();                // damping keeps moving a little after the mouse stops
+  frameRequested = false;
+  const damping = controls.update();  // true while the view still glides after the mouse stops
   const moving = now - lastChange < MOVING_MS;
   if (!moving && layers.coarse) needsRender = true;      // show the full map once still
   if (needsRender) {
@@ -61,7 +71,8 @@ function animate(now) {
   } else {
     previousFrame = null;
   }
-  requestAnimationFrame(animate);
+  // Go on while the view moves or the full map is still to be shown once it stops.
+  if (damping || moving || layers.coarse || needsRender) scheduleFrame();
 }
 
 function resize() {
@@ -151,4 +162,4 @@ const hook = {
 window.plslamViewer = hook;
 
 new SceneClient({ onScene, onError: showError }).start();
-requestAnimationFrame(animate);
+scheduleFrame();
