@@ -80,6 +80,10 @@ void LoopCloser::insert(map::KeyFrame* kf) {
   cv_.notify_all();
 }
 
+void LoopCloser::global_ba_after_keyframe(long keyframe_id) {
+  if (options_.global_ba && options_.global_ba_after_relocalization) revisit_keyframe_ = keyframe_id;
+}
+
 bool LoopCloser::try_pause() {
   std::lock_guard lock(queue_mutex_);
   if (busy_ || !queue_.empty()) return false;
@@ -293,16 +297,31 @@ bool LoopCloser::plausible(map::KeyFrame* query, map::KeyFrame* candidate, const
 }
 
 void LoopCloser::process(map::KeyFrame* kf) {
-  if (kf->is_bad()) return;
+  const bool loop_closed = close_loop(kf);
+  const long revisit = revisit_keyframe_;
+  if (revisit < 0 || kf->id() < revisit) return;
+  revisit_keyframe_ = -1;
+  if (loop_closed) return;  // the loop started its own global BA
+  spdlog::info("global BA after the relocalized revisit: keyframe {} (frame {})", kf->id(), kf->frame_id());
+  {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.global_ba_after_relocalization;
+  }
+  abort_global_ba();  // an older one's snapshot predates the revisit
+  start_global_ba();
+}
+
+bool LoopCloser::close_loop(map::KeyFrame* kf) {
+  if (kf->is_bad()) return false;
   // A loop corrected while this keyframe waited in the queue may have fused its points into the
   // place's: its covisibility must say so before the detector and the guard below read it.
   if (map_.big_changes() > 0) kf->update_connections();
   const auto detections = detector_.detect(kf);
-  if (detections.empty()) return;
-  if (last_loop_keyframe_ >= 0 && kf->id() < last_loop_keyframe_ + options_.keyframes_between_loops) return;
+  if (detections.empty()) return false;
+  if (last_loop_keyframe_ >= 0 && kf->id() < last_loop_keyframe_ + options_.keyframes_between_loops) return false;
   // Local BA moves the keyframes and points the verification compares: pause it from here on.
   MapperPause pause(mapper_);
-  if (kf->is_bad()) return;
+  if (kf->is_bad()) return false;
   std::optional<LoopConstraint> loop;
   int rejected = 0;
   // A place the keyframe's neighbourhood already shares keyframes with is already tied to it (an
@@ -325,7 +344,7 @@ void LoopCloser::process(map::KeyFrame* kf) {
     stats_.detections += static_cast<int>(detections.size());
     stats_.rejected += rejected;
   }
-  if (!loop) return;
+  if (!loop) return false;
   abort_global_ba();  // its snapshot predates this loop
   const auto t0 = std::chrono::steady_clock::now();
   LoopCorrectionResult corrected;
@@ -353,7 +372,11 @@ void LoopCloser::process(map::KeyFrame* kf) {
     std::lock_guard lock(stats_mutex_);
     stats_.loops.push_back(rec);
   }
-  if (!options_.global_ba) return;
+  if (options_.global_ba) start_global_ba();
+  return true;
+}
+
+void LoopCloser::start_global_ba() {
   if (!thread_.joinable()) {  // sequential: in the caller, for reproducible runs
     global_ba();
     return;

@@ -39,6 +39,11 @@ struct LoopClosingOptions {
   int keyframes_between_loops = 10;
   // Global BA after each loop, in its own thread (in the caller's with process_pending()).
   bool global_ba = true;
+  // Also after a revisit that tracking found by relocalizing in the same map (a kidnapped camera,
+  // or a loss): loop detection skips such a place, since relocalization already tied the new
+  // keyframes to it, so without this the revisit's keyframes never meet the first pass's in one
+  // optimisation. Needs global_ba.
+  bool global_ba_after_relocalization = true;
   GlobalBaOptions global_ba_options;
   // At the end of a run, how long finish() waits for a running global BA before aborting it.
   double finish_wait_s = 120;
@@ -65,6 +70,7 @@ struct LoopClosingStats {
   std::vector<double> global_ba_ms;  // per merged global BA: snapshot, optimisation and merge
   int global_ba_runs = 0;            // merged
   int global_ba_aborted = 0;         // made obsolete by a newer loop, or cut at finish()
+  int global_ba_after_relocalization = 0;  // started for a relocalized revisit (no loop)
 };
 
 class LoopCloser {
@@ -79,6 +85,10 @@ class LoopCloser {
   // Processes what is queued, then stops and joins.
   void stop();
   void insert(map::KeyFrame* kf);
+  // Tracking relocalized in the same map after a loss, and keyframe `keyframe_id` is the first it
+  // made since: once that keyframe (or a later one, if it was culled) has been mapped and passed
+  // through loop detection without a loop, a global BA runs (global_ba_after_relocalization).
+  void global_ba_after_keyframe(long keyframe_id);
   // Processes every queued keyframe in the calling thread (sequential mode and tests).
   void process_pending();
   void wait_idle();
@@ -94,6 +104,10 @@ class LoopCloser {
  private:
   void run();
   void process(map::KeyFrame* kf);
+  // Detection, verification and correction; true if a loop was closed.
+  bool close_loop(map::KeyFrame* kf);
+  // Global BA in its own thread (in the caller's in sequential mode).
+  void start_global_ba();
   // Verification and the projection check; the constraint to correct with, if the place holds.
   std::optional<LoopConstraint> confirm(map::KeyFrame* kf, const LoopDetection& d);
   // Whether moving the query to T_qw_corrected is within what odometry drift can explain.
@@ -108,6 +122,7 @@ class LoopCloser {
   LoopClosingOptions options_;
   LoopDetector detector_;
   long last_loop_keyframe_ = -1;
+  std::atomic<long> revisit_keyframe_{-1};  // global_ba_after_keyframe()'s id, until served
 
   mutable std::mutex queue_mutex_;
   std::condition_variable cv_;

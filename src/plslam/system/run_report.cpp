@@ -37,7 +37,8 @@ std::vector<double> loop_correction_ms(const System& slam) {
 nlohmann::json loop_closing_json(const System& slam) {
   if (!slam.loop_closer()) return {{"enabled", false}};
   const auto s = slam.loop_closer()->stats();
-  return {{"enabled", true}, {"detections", s.detections}, {"rejected", s.rejected}, {"implausible", s.implausible}};
+  return {{"enabled", true}, {"detections", s.detections}, {"rejected", s.rejected}, {"implausible", s.implausible},
+          {"global_ba_after_relocalization", s.global_ba_after_relocalization}};
 }
 
 nlohmann::json global_ba_ms(const System& slam) {

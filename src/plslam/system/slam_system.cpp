@@ -88,6 +88,7 @@ FrameResult System::process(const io::StereoFrame& frame) {
   auto data = extractor_.extract(static_cast<long>(frame.index), frame.timestamp, frame.left, frame.right, &r.extraction);
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
+  note_revisit(r.track);
   if (options_.sequential) {
     mapper_->process_pending();
     if (loop_closer_) loop_closer_->process_pending();
@@ -96,6 +97,17 @@ FrameResult System::process(const io::StereoFrame& frame) {
   r.map_size = map_.sizes();
   r.rss_mb = core::resident_memory_mb();
   return r;
+}
+
+void System::note_revisit(const tracking::TrackResult& track) {
+  // A relocalization that follows tracked frames is a revisit (the first pose of a loaded map is
+  // not); its first new keyframe is where the revisit joins the map.
+  if (track.relocalized && tracked_before_) revisit_pending_ = true;
+  if (track.tracked) tracked_before_ = true;
+  if (!revisit_pending_ || !track.keyframe || tracker_->records().empty()) return;
+  revisit_pending_ = false;
+  const map::KeyFrame* kf = tracker_->records().back().reference;
+  if (loop_closer_ && kf) loop_closer_->global_ba_after_keyframe(kf->id());
 }
 
 void System::reclaim_culled() {

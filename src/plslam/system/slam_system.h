@@ -103,6 +103,8 @@ class System {
   // local mapping and loop closing idle (held paused meanwhile), no global BA. At most once per
   // new keyframe; when a thread is busy, a later frame does it.
   void reclaim_culled();
+  // After a relocalization in the same map, asks loop closing for a global BA at the next keyframe.
+  void note_revisit(const tracking::TrackResult& track);
 
   SystemOptions options_;
   map::Map map_;
@@ -113,7 +115,9 @@ class System {
   std::unique_ptr<tracking::Tracker> tracker_;
   StereoCalibration calib_;
   bool finished_ = false;
-  long reclaimed_at_keyframe_ = 0;  // map_.next_ids().keyframe at the last reclamation
+  long reclaimed_at_keyframe_ = 0;
+  bool tracked_before_ = false;   // some frame of this run was tracked
+  bool revisit_pending_ = false;  // relocalized after a loss; its first keyframe asks for a global BA  // map_.next_ids().keyframe at the last reclamation
   ReclaimStats reclaim_stats_;
 };
 

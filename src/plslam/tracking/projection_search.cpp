@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <unordered_set>
 
 #include <opencv2/features2d.hpp>
@@ -27,7 +28,41 @@ bool stereo_consistent(const map::FrameData& d, int j, double u_right, double ra
   return ur < 0 || std::abs(u_right - ur) <= radius;
 }
 
+// Where a map point shows in a frame, if the frame can see it (ORB-SLAM2's isInFrustum): in front,
+// inside the image, within the point's scale range, and seen less than 60 degrees off its mean
+// viewing direction.
+struct Visibility {
+  Eigen::Vector3d Xc;
+  Eigen::Vector2d uv;
+  double distance = 0;
+  double view_cos = 0;
+};
+
+std::optional<Visibility> visibility(const map::MapPoint& mp, const geometry::SE3& T_cw, const Eigen::Vector3d& Ow,
+                                     const geometry::StereoCamera& cam) {
+  Visibility v;
+  const Eigen::Vector3d P = mp.position();
+  v.Xc = T_cw * P;
+  if (v.Xc.z() <= 0) return std::nullopt;
+  v.uv = cam.project(v.Xc);
+  if (!cam.in_image(v.uv)) return std::nullopt;
+  const Eigen::Vector3d ray = P - Ow;
+  v.distance = ray.norm();
+  if (v.distance < mp.min_distance() || v.distance > mp.max_distance()) return std::nullopt;
+  v.view_cos = ray.dot(mp.normal()) / v.distance;
+  if (v.view_cos < 0.5) return std::nullopt;
+  return v;
+}
+
 }  // namespace
+
+int count_visible_points(const Frame& f, const std::vector<map::MapPoint*>& points) {
+  const geometry::StereoCamera cam(f.data->calib);
+  const Eigen::Vector3d Ow = f.T_cw.inverse().translation();
+  int n = 0;
+  for (const map::MapPoint* mp : points) n += mp && !mp->is_bad() && visibility(*mp, f.T_cw, Ow, cam).has_value();
+  return n;
+}
 
 int search_points_from_frame(Frame& cur, const Frame& last, double radius, const SearchOptions& o) {
   const auto& d = *cur.data;
@@ -81,16 +116,11 @@ int search_points_in_local_map(Frame& cur, const std::vector<map::MapPoint*>& ca
   int matches = 0;
   for (map::MapPoint* mp : candidates_in) {
     if (!mp || mp->is_bad() || already.count(mp)) continue;
-    const Eigen::Vector3d P = mp->position();
-    const Eigen::Vector3d Xc = cur.T_cw * P;
-    if (Xc.z() <= 0) continue;
-    const Eigen::Vector2d uv = cam.project(Xc);
-    if (!cam.in_image(uv)) continue;
-    const Eigen::Vector3d ray = P - Ow;
-    const double dist = ray.norm();
-    if (dist < mp->min_distance() || dist > mp->max_distance()) continue;
-    const double view_cos = ray.dot(mp->normal()) / dist;
-    if (view_cos < 0.5) continue;
+    const auto v = visibility(*mp, cur.T_cw, Ow, cam);
+    if (!v) continue;
+    const Eigen::Vector3d& Xc = v->Xc;
+    const Eigen::Vector2d& uv = v->uv;
+    const double dist = v->distance, view_cos = v->view_cos;
     mp->increase_visible();
     const int level = mp->predict_level(dist, d.levels, d.scale_factor);
     const double r = radius * (view_cos > 0.998 ? 2.5 : 4.0) * d.level_scale(level);

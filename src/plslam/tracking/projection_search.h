@@ -24,6 +24,10 @@ int search_points_from_frame(Frame& cur, const Frame& last, double radius, const
 int search_points_in_local_map(Frame& cur, const std::vector<map::MapPoint*>& candidates, double radius,
                                const SearchOptions& o = {});
 
+// How many of `points` the frame can see from its pose (in front, inside the image, within their
+// scale range, less than 60 degrees off their mean viewing direction), matched or not.
+int count_visible_points(const Frame& f, const std::vector<map::MapPoint*>& points);
+
 // Matches map lines projected with cur.T_cw: a candidate frame line must be nearly parallel to the
 // projected segment, lie within `radius` pixels of it (both endpoints' distances to the candidate
 // line) and overlap it; the smallest LBD distance under the threshold wins.

@@ -33,6 +33,9 @@ struct RelocalizationOptions {
   double search_radius = 3.0;      // factor of the local-map search window, around the PnP pose
   int search_covisibles = 10;      // the candidate's best covisibles whose landmarks are searched too
   int min_inliers = 50;            // point + line inliers to accept (ORB-SLAM2: 50 points)
+  // ... and matches to at least this share of the candidate neighbourhood's map points that are
+  // visible from the pose found: a look-alike place matches only what repeats.
+  double min_found_ratio = 0.15;
   // A camera that stays lost this long on frames that could start a map (seconds of textured
   // frames, so a black-out does not count) starts a new map segment instead.
   double new_segment_after_s = 1.0;
