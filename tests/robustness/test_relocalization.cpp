@@ -3,6 +3,8 @@
 // the fallbacks: without place recognition, and when relocalization keeps failing, a new map
 // segment; a bad vocabulary file is refused before the first frame.
 #include <fstream>
+#include <iostream>
+#include <memory>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -110,60 +112,109 @@ TEST(RelocalizationConcurrent, KidnappedKittiCameraIsFoundAgainWhileLocalMapping
   EXPECT_EQ(stats["global_ba_runs"].get<int>() + stats["global_ba_aborted"].get<int>(), 1);
 }
 
-// A look-alike place is not where the camera is. The rendered office loop (seed 1) with frames
-// 300-319 black: the camera turns during the black-out and comes back facing what the map has
-// not seen, and what the database offers are look-alikes (the shelves hold the same books on both
-// faces). Before relocalization asked the place to explain its visible map points, frame 335
-// relocalized against a shelf 4 m away with 86 inliers, and the run went on there without a word
-// (ATE 2.9 m). Relocalizing at the true place or starting a new segment are both fine; a pose
-// called relocalized that is not where the camera is, is not.
-TEST(Relocalization, ALookAlikePlaceAfterABlackOutIsNotTakenForTheCamerasPlace) {
-  test::TempDir tmp;
-  const fs::path seq = tmp.path() / "office";
-  const auto synth = test::run_cli("synth --out \"" + seq.string() +
-                                   "\" --scene office --preset euroc --frames 480 --loop --seed 1 --threads 2");
-  ASSERT_EQ(synth.exit_code, 0) << synth.err;
-  constexpr std::size_t kBlackFrom = 300, kBlackTo = 320, kFrames = 346;
-  for (const char* cam : {"cam0", "cam1"}) {
-    std::vector<fs::path> images;
-    for (const auto& e : fs::directory_iterator(seq / "mav0" / cam / "data")) images.push_back(e.path());
-    std::sort(images.begin(), images.end(), [](const fs::path& a, const fs::path& b) {
-      return std::stoll(a.stem().string()) < std::stoll(b.stem().string());
-    });
-    ASSERT_EQ(images.size(), 480u);
-    const cv::Mat black = cv::Mat::zeros(cv::imread(images.front().string(), cv::IMREAD_GRAYSCALE).size(), CV_8U);
-    for (std::size_t i = kBlackFrom; i < kBlackTo; ++i) ASSERT_TRUE(cv::imwrite(images[i].string(), black));
+// After 1 s of black frames the motion model is a second out of date, and the rendered office
+// (seed 1) offers look-alike places: its shelves hold the same books on both faces. Whatever the
+// system does after the black-out (track on, relocalize, start a new map segment), every pose it
+// gives in the map it had must be where the camera is. Two black-outs that each ended elsewhere,
+// with exit 0 and one warning at most:
+// - frames 120-139: frame 140 was tracked 2 m and 17 deg from the prediction with 46 inliers (a
+//   suspect jump, reported and kept) and the rest of the run followed it (ATE 1.54 m);
+// - frames 300-319: the camera comes back facing what the map has not seen, and frame 335
+//   relocalized against a shelf 4 m away with 86 inliers (ATE 2.9 m).
+// Now frame 140 relocalizes where it is, and 300-319 ends in a new map segment.
+class BlackOut : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    tmp_ = std::make_unique<test::TempDir>();
+    const auto synth = test::run_cli("synth --out \"" + office().string() +
+                                     "\" --scene office --preset euroc --frames 480 --loop --seed 1 --threads 2");
+    ASSERT_EQ(synth.exit_code, 0) << synth.err;
   }
-  const auto r = test::run(seq, tmp.path() / "out", fmt::format("--max-frames {}", kFrames));
-  ASSERT_EQ(r.cli.exit_code, 0) << r.cli.err;
+  static void TearDownTestSuite() { tmp_.reset(); }
+  static fs::path office() { return tmp_->path() / "office"; }
+
+  // Frames black_from..black_from+19 black, run up to `frames` frames; checks every tracked
+  // frame after the black-out up to a new segment against the ground truth, aligned on the frames
+  // before it. Returns the run's stats.
+  static nlohmann::json run_with_black_out(std::size_t black_from, std::size_t frames) {
+    const fs::path seq = tmp_->path() / fmt::format("black-{}", black_from);
+    fs::create_directories(seq / "mav0");
+    for (const auto& e : fs::directory_iterator(office() / "mav0")) {
+      fs::create_directory_symlink(e.path(), seq / "mav0" / e.path().filename());
+    }
+    for (const char* cam : {"cam0", "cam1"}) {  // own copies of the camera folders, images linked
+      const fs::path dst = seq / "mav0" / cam;
+      fs::remove(dst);
+      fs::create_directories(dst / "data");
+      fs::copy_file(office() / "mav0" / cam / "data.csv", dst / "data.csv");
+      fs::copy_file(office() / "mav0" / cam / "sensor.yaml", dst / "sensor.yaml");
+      std::vector<fs::path> images;
+      for (const auto& e : fs::directory_iterator(office() / "mav0" / cam / "data")) images.push_back(e.path());
+      std::sort(images.begin(), images.end(), [](const fs::path& a, const fs::path& b) {
+        return std::stoll(a.stem().string()) < std::stoll(b.stem().string());
+      });
+      EXPECT_EQ(images.size(), 480u);
+      const cv::Mat black = cv::Mat::zeros(cv::imread(images.front().string(), cv::IMREAD_GRAYSCALE).size(), CV_8U);
+      for (std::size_t i = 0; i < images.size(); ++i) {
+        const fs::path to = dst / "data" / images[i].filename();
+        if (i >= black_from && i < black_from + 20) {
+          EXPECT_TRUE(cv::imwrite(to.string(), black));
+        } else {
+          fs::create_symlink(images[i], to);
+        }
+      }
+    }
+    const auto r = test::run(seq, tmp_->path() / fmt::format("out-{}", black_from), fmt::format("--max-frames {}", frames));
+    EXPECT_EQ(r.cli.exit_code, 0) << r.cli.err;
+    if (r.stats.is_null()) return r.stats;
+    const auto est = io::read_trajectory(r.out / "trajectory.tum", io::TrajectoryFormat::kTum);
+    const auto gt = io::read_trajectory(office() / "mav0" / "synth" / "left_camera.tum", io::TrajectoryFormat::kTum);
+    std::vector<double> gt_t, est_t;
+    for (const auto& p : gt) gt_t.push_back(p.t);
+    for (const auto& p : est) est_t.push_back(p.t);
+    const auto pairs = eval::associate_by_time(gt_t, est_t, 0.01);
+    Trajectory g, e;
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      if (gt[pairs.gt[k]].t >= gt.at(black_from).t) continue;
+      g.push_back(gt[pairs.gt[k]]);
+      e.push_back(est[pairs.est[k]]);
+    }
+    EXPECT_GT(g.size(), black_from - 5);
+    const auto aligned = eval::apply_alignment(est, eval::solve_alignment(g, e, eval::AlignMode::kSE3));
+    const auto segments = r.stats["new_map_segments"]["frames"].get<std::vector<long>>();
+    const double segment_time = segments.empty() ? 1e18 : gt.at(static_cast<std::size_t>(segments.front())).t;
+    std::size_t checked = 0;
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const double t = gt[pairs.gt[k]].t;
+      if (t < gt.at(black_from).t || t >= segment_time) continue;
+      ++checked;
+      const double error = (aligned[pairs.est[k]].T.translation() - gt[pairs.gt[k]].T.translation()).norm();
+      EXPECT_LT(error, 0.3) << "frame at t = " << t << " is " << error << " m from where the camera is";
+    }
+    std::cout << "black-out from frame " << black_from << ": " << checked << " poses after it checked, relocalized "
+              << r.stats["relocalizations"]["frames"].dump() << ", new segments " << r.stats["new_map_segments"]["frames"].dump()
+              << "\n";
+    return r.stats;
+  }
+
+  static std::unique_ptr<test::TempDir> tmp_;
+};
+
+std::unique_ptr<test::TempDir> BlackOut::tmp_;
+
+TEST_F(BlackOut, AJumpToALookAlikePlaceIsRelocalizedInstead) {
+  const auto stats = run_with_black_out(120, 180);
+  ASSERT_FALSE(stats.is_null());
+  EXPECT_EQ(stats["new_map_segments"]["count"], 0);
+  EXPECT_GE(stats["relocalizations"]["count"].get<int>(), 1);
+}
+
+TEST_F(BlackOut, ALookAlikePlaceIsNotTakenForTheCamerasPlace) {
+  const auto stats = run_with_black_out(300, 346);
+  ASSERT_FALSE(stats.is_null());
   // The scene does what this test is about: the camera is lost after the black-out.
-  ASSERT_GE(r.stats["lost_events"].get<int>(), 1) << r.stats.dump(2);
-  const auto reloc = r.stats["relocalizations"]["frames"].get<std::vector<long>>();
-  EXPECT_GE(reloc.size() + r.stats["new_map_segments"]["count"].get<std::size_t>(), 1u);
-  // Positions in the ground truth's frame, aligned on the frames before the black-out.
-  const auto est = io::read_trajectory(r.out / "trajectory.tum", io::TrajectoryFormat::kTum);
-  const auto gt = io::read_trajectory(seq / "mav0" / "synth" / "left_camera.tum", io::TrajectoryFormat::kTum);
-  std::vector<double> gt_t, est_t;
-  for (const auto& p : gt) gt_t.push_back(p.t);
-  for (const auto& p : est) est_t.push_back(p.t);
-  const auto pairs = eval::associate_by_time(gt_t, est_t, 0.01);
-  Trajectory g, e;
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    if (gt[pairs.gt[k]].t >= gt[kBlackFrom].t) continue;
-    g.push_back(gt[pairs.gt[k]]);
-    e.push_back(est[pairs.est[k]]);
-  }
-  ASSERT_GT(g.size(), 250u);
-  const auto alignment = eval::solve_alignment(g, e, eval::AlignMode::kSE3);
-  const auto aligned = eval::apply_alignment(est, alignment);
-  for (const long frame : reloc) {
-    const double t = gt.at(static_cast<std::size_t>(frame)).t;
-    std::size_t k = 0;
-    while (k < pairs.size() && gt[pairs.gt[k]].t != t) ++k;
-    ASSERT_LT(k, pairs.size()) << "relocalized frame " << frame << " has no pose";
-    const double error = (aligned[pairs.est[k]].T.translation() - gt[pairs.gt[k]].T.translation()).norm();
-    EXPECT_LT(error, 0.3) << "frame " << frame << " relocalized " << error << " m from where the camera is";
-  }
+  EXPECT_GE(stats["lost_events"].get<int>(), 1);
+  EXPECT_GE(stats["relocalizations"]["count"].get<int>() + stats["new_map_segments"]["count"].get<int>(), 1);
 }
 
 TEST(Relocalization, WithoutPlaceRecognitionALostCameraStartsANewSegment) {

@@ -99,7 +99,7 @@ geometry::SE3 Tracker::Anchor::T_cw() const { return keyframe ? T_ck * keyframe-
 
 geometry::SE3 Tracker::pose_of(const FrameRecord& r) { return anchor_of(r).T_cw(); }
 
-void Tracker::check_motion(const Frame& f) {
+bool Tracker::check_motion(const Frame& f) {
   const geometry::SE3 predicted = predicted_pose(f);
   const double m = (f.T_cw.inverse().translation() - predicted.inverse().translation()).norm();
   const double deg = geometry::so3_log(f.T_cw.rotation() * predicted.rotation().transpose()).norm() * 180.0 / std::numbers::pi;
@@ -107,11 +107,22 @@ void Tracker::check_motion(const Frame& f) {
   motion_deviation_deg_.push_back(deg);
   const bool far = options_.jump_deviation_m > 0 && m > options_.jump_deviation_m;
   const bool turned = options_.jump_deviation_deg > 0 && deg > options_.jump_deviation_deg;
-  if (!far && !turned) return;
+  if (!far && !turned) return false;
   suspect_jumps_.push_back({f.id(), m, deg});
   spdlog::warn("frame {}: suspect jump: the tracked pose is {:.2f} m and {:.1f} deg from the motion model's "
                "prediction (limits {} m, {} deg)",
                f.id(), m, deg, options_.jump_deviation_m, options_.jump_deviation_deg);
+  return true;
+}
+
+bool Tracker::explains_local_map(const Frame& f) const {
+  int matched = 0;
+  for (std::size_t i = 0; i < f.points.size(); ++i) matched += f.points[i] && !f.point_outlier[i];
+  const int visible = count_visible_points(f, local_points_);
+  const bool ok = matched >= options_.relocalization.min_found_ratio * visible;
+  spdlog::log(ok ? spdlog::level::info : spdlog::level::warn, "frame {}: {} of the {} local map points visible from the "
+              "jumped pose matched: {}", f.id(), matched, visible, ok ? "kept" : "a look-alike place, relocalizing");
+  return ok;
 }
 
 TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
@@ -160,9 +171,11 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     if (tracked) {
       tracked = track_local_map(f, result.times, result.point_inliers, result.line_inliers);
     }
+    // A pose far from the prediction that explains little of what the map shows there is a
+    // look-alike place (after a black-out the motion model is a second or more out of date).
+    if (tracked && velocity_ && check_motion(f) && !explains_local_map(f)) tracked = false;
     if (tracked) {
       ok = true;
-      if (velocity_) check_motion(f);
       velocity_ = (f.T_cw * last_->T_cw.inverse()).normalized();
       velocity_dt_ = f.data->timestamp - last_->data->timestamp;
       finish_tracked_frame(f, result);

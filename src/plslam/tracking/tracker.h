@@ -69,7 +69,9 @@ struct TrackerOptions {
   // A tracked pose further than this from the constant-velocity prediction (camera centre, or
   // rotation) is a suspect jump: tracking may have settled on a look-alike place that the
   // following frames then agree with. It is reported (warning, stats.json suspect_jumps), never
-  // silently kept; the pose itself is kept. 0: no check. The largest deviations of good runs, on
+  // silently kept. The pose is kept when it matches at least relocalization.min_found_ratio of
+  // the local map points visible from it; otherwise it is a look-alike and the frame counts as
+  // lost (it is relocalized at once). 0: no check. The largest deviations of good runs, on
   // the real excerpts and the rendered office, corridor and street loop (concurrent and
   // sequential): 0.15 m and 1.3 deg (a car on the street loop); a look-alike corner once gave 1 m
   // and 12 deg.
@@ -224,8 +226,11 @@ class Tracker {
   double close_depth(const Frame& f) const;
   // Where the constant-velocity model puts `f`, from the last frame and the time between them.
   geometry::SE3 predicted_pose(const Frame& f) const;
-  // Compares the tracked pose of `f` with the prediction (call before the velocity is updated).
-  void check_motion(const Frame& f);
+  // Compares the tracked pose of `f` with the prediction (call before the velocity is updated);
+  // true for a suspect jump.
+  bool check_motion(const Frame& f);
+  // Whether the matches of `f` are at least min_found_ratio of the local map points it can see.
+  bool explains_local_map(const Frame& f) const;
 
   map::Map& map_;
   TrackerOptions options_;
