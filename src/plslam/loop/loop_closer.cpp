@@ -298,9 +298,11 @@ bool LoopCloser::plausible(map::KeyFrame* query, map::KeyFrame* candidate, const
 
 void LoopCloser::process(map::KeyFrame* kf) {
   const bool loop_closed = close_loop(kf);
-  const long revisit = revisit_keyframe_;
+  long revisit = revisit_keyframe_;
   if (revisit < 0 || kf->id() < revisit) return;
-  revisit_keyframe_ = -1;
+  // Tracking may have asked again meanwhile (a second relocalization): that one waits for its own
+  // keyframe.
+  if (!revisit_keyframe_.compare_exchange_strong(revisit, -1)) return;
   if (loop_closed) return;  // the loop started its own global BA
   spdlog::info("global BA after the relocalized revisit: keyframe {} (frame {})", kf->id(), kf->frame_id());
   {
