@@ -58,7 +58,7 @@ function render(coarse = false) {
 
 function animate(now) {
   frameRequested = false;
-  const damping = controls.update();  // true while the view still glides after the mouse stops
+  controls.update();                // damping keeps the view gliding ('change') after the mouse stops
   const moving = now - lastChange < MOVING_MS;
   if (!moving && layers.coarse) needsRender = true;      // show the full map once still
   if (needsRender) {
@@ -71,8 +71,9 @@ function animate(now) {
   } else {
     previousFrame = null;
   }
-  // Go on while the view moves or the full map is still to be shown once it stops.
-  if (damping || moving || layers.coarse || needsRender) scheduleFrame();
+  // Go on while the view moves (each 'change' renews lastChange) or the full map is still to be
+  // shown once it stops.
+  if (moving || layers.coarse) scheduleFrame();
 }
 
 function resize() {

@@ -115,14 +115,12 @@ bool Tracker::check_motion(const Frame& f) {
   return true;
 }
 
-bool Tracker::explains_local_map(const Frame& f) const {
-  int matched = 0;
-  for (std::size_t i = 0; i < f.points.size(); ++i) matched += f.points[i] && !f.point_outlier[i];
-  const int visible = count_visible_points(f, local_points_);
-  const bool ok = matched >= options_.relocalization.min_found_ratio * visible;
-  spdlog::log(ok ? spdlog::level::info : spdlog::level::warn, "frame {}: {} of the {} local map points visible from the "
-              "jumped pose matched: {}", f.id(), matched, visible, ok ? "kept" : "a look-alike place, relocalizing");
-  return ok;
+Tracker::Explained Tracker::explained(const Frame& f, const std::vector<map::MapPoint*>& points) const {
+  Explained e;
+  e.matched = f.num_matched_points();
+  e.visible = count_visible_points(f, points);
+  e.enough = e.matched >= options_.relocalization.min_found_ratio * e.visible;
+  return e;
 }
 
 TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
@@ -173,7 +171,13 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     }
     // A pose far from the prediction that explains little of what the map shows there is a
     // look-alike place (after a black-out the motion model is a second or more out of date).
-    if (tracked && velocity_ && check_motion(f) && !explains_local_map(f)) tracked = false;
+    if (tracked && velocity_ && check_motion(f)) {
+      const auto e = explained(f, local_points_);
+      spdlog::log(e.enough ? spdlog::level::info : spdlog::level::warn,
+                  "frame {}: {} of the {} local map points visible from the jumped pose matched: {}", f.id(), e.matched,
+                  e.visible, e.enough ? "kept" : "a look-alike place, relocalizing");
+      tracked = e.enough;
+    }
     if (tracked) {
       ok = true;
       velocity_ = (f.T_cw * last_->T_cw.inverse()).normalized();

@@ -229,8 +229,15 @@ class Tracker {
   // Compares the tracked pose of `f` with the prediction (call before the velocity is updated);
   // true for a suspect jump.
   bool check_motion(const Frame& f);
-  // Whether the matches of `f` are at least min_found_ratio of the local map points it can see.
-  bool explains_local_map(const Frame& f) const;
+  // How many of `points` are visible from the pose of `f`, how many map points `f` matched, and
+  // whether those are at least relocalization.min_found_ratio of them: a true place explains a
+  // good share of what the map shows there, a look-alike only what repeats.
+  struct Explained {
+    int matched = 0;
+    int visible = 0;
+    bool enough = false;
+  };
+  Explained explained(const Frame& f, const std::vector<map::MapPoint*>& points) const;
 
   map::Map& map_;
   TrackerOptions options_;

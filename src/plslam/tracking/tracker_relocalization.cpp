@@ -96,12 +96,9 @@ bool Tracker::relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id) {
     // points its neighbourhood says are visible from the pose (0.24-0.34 on the rendered office and
     // KITTI 06), a look-alike only the repeated part (0.05-0.08: a shelf with the same books 4 m
     // away, accepted with 86 inliers before this check).
-    const int visible = count_visible_points(c_frame, points);
-    int matched = 0;
-    for (const map::MapPoint* mp : c_frame.points) matched += mp != nullptr;
-    if (matched < o.min_found_ratio * visible) {
+    if (const auto e = explained(c_frame, points); !e.enough) {
       spdlog::debug("frame {}: relocalization against keyframe {} rejected: {} of {} visible map points matched",
-                    f.id(), kf->id(), matched, visible);
+                    f.id(), kf->id(), e.matched, e.visible);
       continue;
     }
     if (last_centre) {
