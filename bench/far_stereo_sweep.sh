@@ -29,16 +29,17 @@ mkdir -p "$out/configs" "$out/runs"
 summary="$out/summary.txt"
 : > "$summary"
 
-for frames in 300 600; do
-  [ -d "$out/street$frames" ] || "$plslam" synth --out "$out/street$frames" --scene street --preset kitti \
-    --format kitti --frames "$frames" --loop --seed 2 >/dev/null
-done
 for v in $values; do
   # The KITTI preset with the rule replaced (the key sits in its tracking section).
   awk -v v="$v" '$1 == "far_stereo_baselines:" { sub(/far_stereo_baselines: *[0-9.]+/, "far_stereo_baselines: " v) } { print }' \
     config/kitti.yaml > "$out/configs/far$v.yaml"
-  grep -q "far_stereo_baselines: $v\b" "$out/configs/far$v.yaml" ||
-    printf 'tracking:\n  far_stereo_baselines: %s\n' "$v" > "$out/configs/far$v.yaml"
+  grep -q "^  far_stereo_baselines: $v\b" "$out/configs/far$v.yaml" ||
+    { echo "far_stereo_sweep.sh: no tracking.far_stereo_baselines in config/kitti.yaml to replace" >&2; exit 2; }
+done
+
+for frames in 300 600; do
+  [ -d "$out/street$frames" ] || "$plslam" synth --out "$out/street$frames" --scene street --preset kitti \
+    --format kitti --frames "$frames" --loop --seed 2 >/dev/null
 done
 
 # cell NAME DATASET [ARGS...]: N runs per value, alternating, one summary line each.
