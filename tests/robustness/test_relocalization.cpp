@@ -121,7 +121,10 @@ TEST(RelocalizationConcurrent, KidnappedKittiCameraIsFoundAgainWhileLocalMapping
 //   suspect jump, reported and kept) and the rest of the run followed it (ATE 1.54 m);
 // - frames 300-319: the camera comes back facing what the map has not seen, and frame 335
 //   relocalized against a shelf 4 m away with 86 inliers (ATE 2.9 m).
-// Now frame 140 relocalizes where it is, and 300-319 ends in a new map segment.
+// Now frame 140 is found where it is, and 300-319 ends in a new map segment. How frame 140 is found
+// depends on the matches of that one frame: with right-image lines from a second detection it was
+// lost and relocalized; with guided stereo lines the wide motion-model search tracks it (202
+// inliers, 0.19 m and 16 deg from the stale prediction, reported as a suspect jump). Either is right.
 class BlackOut : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -202,11 +205,13 @@ class BlackOut : public ::testing::Test {
 
 std::unique_ptr<test::TempDir> BlackOut::tmp_;
 
-TEST_F(BlackOut, AJumpToALookAlikePlaceIsRelocalizedInstead) {
+TEST_F(BlackOut, AJumpToALookAlikePlaceIsNotTakenAfterABlackOut) {
   const auto stats = run_with_black_out(120, 180);
   ASSERT_FALSE(stats.is_null());
+  // The same map goes on (the poses after the black-out are checked in run_with_black_out), and
+  // every frame that is not black is tracked, relocalized or not.
   EXPECT_EQ(stats["new_map_segments"]["count"], 0);
-  EXPECT_GE(stats["relocalizations"]["count"].get<int>(), 1);
+  EXPECT_EQ(stats["tracked_frames"].get<int>(), 160);
 }
 
 TEST_F(BlackOut, ALookAlikePlaceIsNotTakenForTheCamerasPlace) {

@@ -122,6 +122,8 @@ std::vector<ConfigKey> make_table() {
     lines_enabled_key(),
     unsigned_field("lines", "max_lines", [](auto& o) -> auto& { return o.extractor.line_extractor.max_lines; },
                    "line segments kept per image", at_least(0)),
+    field("lines", "guided_stereo", [](auto& o) -> auto& { return o.extractor.guided_stereo_lines; },
+          "right-image lines from a search along each left line's rows, instead of a second detection"),
 
     field("tracking", "init_min_points", [](auto& o) -> auto& { return o.tracker.init_min_points; },
           "stereo points a frame needs to start a map"),

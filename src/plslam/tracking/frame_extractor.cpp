@@ -35,6 +35,10 @@ FrameExtractor::FrameExtractor(const StereoCalibration& calib, FrameExtractorOpt
   options_.stereo_points.bf = calib_.bf();
   options_.stereo_points.baseline = calib_.baseline;
   options_.stereo_points.validate();
+  // The guided search compares right descriptors with the left ones, so it makes them alike.
+  options_.guided_lines.lbd_scale = options_.line_extractor.detector.scale;
+  options_.guided_lines.lbd = options_.line_extractor.lbd;
+  options_.guided_lines.validate();
 }
 
 std::shared_ptr<map::FrameData> FrameExtractor::extract(long frame_id, double timestamp, const cv::Mat& left,
@@ -44,25 +48,34 @@ std::shared_ptr<map::FrameData> FrameExtractor::extract(long frame_id, double ti
   features::LineFeatures ll, lr;
   features::ExtractionTimings tl;
   features::LineTimings tll;
+  matching::StereoPointMatches sp;
+  std::vector<matching::StereoLineMatch> sl;
+  double sp_ms = 0, sl_ms = 0;
   {
     // Plain threads rather than a TBB task group: the join is a synchronisation ThreadSanitizer
     // can see (libtbb is not instrumented), and four coarse tasks do not need a scheduler.
     std::vector<std::future<void>> tasks;
     tasks.push_back(std::async(std::launch::async, [&] { pr = right_orb_.extract(right); }));
     if (options_.lines) {
-      tasks.push_back(std::async(std::launch::async, [&] { ll = features::extract_lines(left, options_.line_extractor, &tll); }));
-      tasks.push_back(std::async(std::launch::async, [&] { lr = features::extract_lines(right, options_.line_extractor); }));
+      tasks.push_back(std::async(std::launch::async, [&] {
+        ll = features::extract_lines(left, options_.line_extractor, &tll);
+        // The guided search needs no right features, so it follows the left lines at once.
+        if (options_.guided_stereo_lines) {
+          const auto s = std::chrono::steady_clock::now();
+          sl = matching::match_stereo_lines_guided(ll, left, right, calib_, options_.stereo_lines, options_.guided_lines);
+          sl_ms = ms_since(s);
+        }
+      }));
+      if (!options_.guided_stereo_lines)
+        tasks.push_back(std::async(std::launch::async, [&] { lr = features::extract_lines(right, options_.line_extractor); }));
     }
     pl = left_orb_.extract(left, &tl);
     for (auto& t : tasks) t.get();
   }
   const auto t1 = std::chrono::steady_clock::now();
-  matching::StereoPointMatches sp;
-  std::vector<matching::StereoLineMatch> sl;
-  double sp_ms = 0, sl_ms = 0;
   {
     std::future<void> lines_task;
-    if (options_.lines) {
+    if (options_.lines && !options_.guided_stereo_lines) {
       lines_task = std::async(std::launch::async, [&] {
         const auto s = std::chrono::steady_clock::now();
         sl = matching::match_stereo_lines(ll, lr, calib_, options_.stereo_lines);
@@ -93,7 +106,12 @@ std::shared_ptr<map::FrameData> FrameExtractor::extract(long frame_id, double ti
   data->line_descriptors = cv::Mat(static_cast<int>(sl.size()), 32, CV_8U);
   for (const auto& m : sl) {
     const auto& a = ll.lines[static_cast<std::size_t>(m.left)];
-    const auto& b = lr.lines[static_cast<std::size_t>(m.right)];
+    // A guided match has no right feature: its right line is the fitted one, through the left
+    // endpoints shifted by their disparities along their rows.
+    const features::LineSegment b =
+        m.right >= 0 ? lr.lines[static_cast<std::size_t>(m.right)]
+                     : features::LineSegment{a.start - cv::Point2f(static_cast<float>(m.disparity_start), 0.f),
+                                             a.end - cv::Point2f(static_cast<float>(m.disparity_end), 0.f)};
     map::LineObservation obs;
     obs.segment = a;
     obs.left_line = geometry::line_through({a.start.x, a.start.y}, {a.end.x, a.end.y});
