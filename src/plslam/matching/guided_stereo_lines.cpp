@@ -267,24 +267,6 @@ int second_inliers(const std::vector<Fit>& fits, double mid, double y_mid, doubl
   return n;
 }
 
-StereoLineMatch make_match(int left, const features::LineSegment& a, double ds, double de, int distance,
-                           const StereoCalibration& calib) {
-  StereoLineMatch r;
-  r.left = left;
-  r.right = -1;
-  r.distance = distance;
-  r.disparity_start = ds;
-  r.disparity_end = de;
-  auto backproject = [&](const cv::Point2f& p, double disp) {
-    const double z = calib.bf() / disp;
-    return Eigen::Vector3d((p.x - calib.cx) * z / calib.fx, (p.y - calib.cy) * z / calib.fy, z);
-  };
-  r.P_start = backproject(a.start, ds);
-  r.P_end = backproject(a.end, de);
-  r.coefficients = line_coefficients(a.start, a.end);
-  return r;
-}
-
 struct Pending {
   int left;
   std::vector<std::pair<double, double>> options;  // endpoint disparities of each candidate
@@ -399,7 +381,7 @@ std::vector<StereoLineMatch> match_stereo_lines_guided(const features::LineFeatu
     // The rows decide alone when one explanation has the strict share and no other as many rows.
     if (first_refined && fits[0].inliers >= needed &&
         fits[0].inliers > second_inliers(fits, mids[0], y_mid, o.inlier_px)) {
-      out.push_back(make_match(i, a, options[0].first, options[0].second, 0, calib));
+      out.push_back(make_stereo_line_match(i, -1, 0, a, options[0].first, options[0].second, calib));
       continue;
     }
     pending.push_back({i, std::move(options)});
@@ -435,7 +417,7 @@ std::vector<StereoLineMatch> match_stereo_lines_guided(const features::LineFeatu
     }
     if (best > mo.max_hamming || (second != INT_MAX && best >= mo.ratio * second)) continue;
     const features::LineSegment& a = L.lines[static_cast<std::size_t>(p.left)];
-    out.push_back(make_match(p.left, a, p.options[pick].first, p.options[pick].second, best, calib));
+    out.push_back(make_stereo_line_match(p.left, -1, best, a, p.options[pick].first, p.options[pick].second, calib));
   }
   std::sort(out.begin(), out.end(), [](const StereoLineMatch& x, const StereoLineMatch& y) { return x.left < y.left; });
   return out;

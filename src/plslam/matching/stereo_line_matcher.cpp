@@ -20,6 +20,24 @@ double column_at_row(const LineSegment& s, double y) {
   return s.start.x + (y - s.start.y) * (s.end.x - s.start.x) / dy;
 }
 
+StereoLineMatch make_stereo_line_match(int left, int right, int distance, const LineSegment& a, double ds, double de,
+                                       const StereoCalibration& calib) {
+  auto backproject = [&](const cv::Point2f& p, double disp) {
+    const double z = calib.bf() / disp;
+    return Eigen::Vector3d((p.x - calib.cx) * z / calib.fx, (p.y - calib.cy) * z / calib.fy, z);
+  };
+  StereoLineMatch m;
+  m.left = left;
+  m.right = right;
+  m.distance = distance;
+  m.disparity_start = ds;
+  m.disparity_end = de;
+  m.P_start = backproject(a.start, ds);
+  m.P_end = backproject(a.end, de);
+  m.coefficients = line_coefficients(a.start, a.end);
+  return m;
+}
+
 namespace {
 
 struct Candidate {
@@ -81,21 +99,7 @@ std::vector<StereoLineMatch> match_stereo_lines(const features::LineFeatures& L,
     if (o.cross_check && c.distance != best_r[c.right]) continue;
     taken_left[c.left] = true;
     taken_right[c.right] = true;
-    const LineSegment& a = L.lines[c.left];
-    StereoLineMatch m;
-    m.left = c.left;
-    m.right = c.right;
-    m.distance = c.distance;
-    m.disparity_start = c.d_start;
-    m.disparity_end = c.d_end;
-    auto backproject = [&](const cv::Point2f& p, double disp) {
-      const double z = calib.bf() / disp;
-      return Eigen::Vector3d((p.x - calib.cx) * z / calib.fx, (p.y - calib.cy) * z / calib.fy, z);
-    };
-    m.P_start = backproject(a.start, c.d_start);
-    m.P_end = backproject(a.end, c.d_end);
-    m.coefficients = line_coefficients(a.start, a.end);
-    out.push_back(m);
+    out.push_back(make_stereo_line_match(c.left, c.right, c.distance, L.lines[c.left], c.d_start, c.d_end, calib));
   }
   return out;
 }

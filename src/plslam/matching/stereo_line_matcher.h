@@ -39,6 +39,11 @@ Eigen::Vector3d line_coefficients(const cv::Point2f& start, const cv::Point2f& e
 // Column where the (infinite) line through s crosses image row y; s must not be horizontal.
 double column_at_row(const features::LineSegment& s, double y);
 
+// The match of left segment `a` with endpoint disparities ds and de (positive): its 3D endpoints
+// back-projected at depth bf / d, and its coefficients.
+StereoLineMatch make_stereo_line_match(int left, int right, int distance, const features::LineSegment& a, double ds,
+                                       double de, const StereoCalibration& calib);
+
 std::vector<StereoLineMatch> match_stereo_lines(const features::LineFeatures& left,
                                                 const features::LineFeatures& right,
                                                 const StereoCalibration& calib,
