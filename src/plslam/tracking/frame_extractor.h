@@ -25,7 +25,7 @@ struct FrameExtractorOptions {
   features::LineExtractorOptions line_extractor;
   matching::StereoLineMatchOptions stereo_lines;
   // Right-image lines from a search along each left line's rows instead of a second detection:
-  // 10-20 % less tracking time at the same ATE (docs/analysis/timing.md).
+  // 7-18 % less tracking time at the same median ATE (docs/analysis/timing.md).
   bool guided_stereo_lines = true;
   matching::GuidedStereoLineOptions guided_lines;
 
