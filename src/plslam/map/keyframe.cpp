@@ -131,15 +131,15 @@ void KeyFrame::update_connections(int min_shared) {
   IdMap<KeyFrame, int> counter;
   for (const auto* p : map_points()) {
     if (!p || p->is_bad()) continue;
-    for (const auto& [kf, idx] : p->observations()) {
+    p->for_each_observation([&](KeyFrame* kf, int) {
       if (kf != this) ++counter[kf];
-    }
+    });
   }
   for (const auto* l : map_lines()) {
     if (!l || l->is_bad()) continue;
-    for (const auto& [kf, idx] : l->observations()) {
+    l->for_each_observation([&](KeyFrame* kf, int) {
       if (kf != this) ++counter[kf];
-    }
+    });
   }
   if (counter.empty()) return;
   KeyFrame* best = nullptr;

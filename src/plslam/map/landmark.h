@@ -47,6 +47,14 @@ class Landmark {
   // Removes one; a landmark left with fewer than two observing keyframes turns bad.
   void erase_observation(KeyFrame* kf);
   IdMap<KeyFrame, int> observations() const;
+  // Calls f(keyframe, index) for each observation under the landmark's lock, without the copy
+  // observations() makes (the per-frame covisibility counts visit thousands of landmarks). f must
+  // take no lock and must not call back into this landmark.
+  template <typename F>
+  void for_each_observation(F&& f) const {
+    std::lock_guard lock(mutex_);
+    for (const auto& [kf, index] : observations_) f(kf, index);
+  }
   int num_observations() const;  // observing keyframes
   // ORB-SLAM's observation count: a stereo observation counts 2, a left-only one 1, because a
   // stereo observation alone fixes the landmark's position. The keyframe decision (tracked map

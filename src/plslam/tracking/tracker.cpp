@@ -443,7 +443,7 @@ void Tracker::update_local_map(Frame& f) {
       f.points[i] = nullptr;
       continue;
     }
-    for (const auto& [kf, idx] : mp->observations()) ++counter[kf];
+    mp->for_each_observation([&](map::KeyFrame* kf, int) { ++counter[kf]; });
   }
   for (std::size_t j = 0; j < f.lines.size(); ++j) {
     map::MapLine* ml = f.lines[j];
@@ -451,7 +451,7 @@ void Tracker::update_local_map(Frame& f) {
       f.lines[j] = nullptr;
       continue;
     }
-    for (const auto& [kf, idx] : ml->observations()) ++counter[kf];
+    ml->for_each_observation([&](map::KeyFrame* kf, int) { ++counter[kf]; });
   }
   local_keyframes_.clear();
   std::unordered_set<map::KeyFrame*> in_set;
