@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -175,6 +176,23 @@ inline double coverage(const GtEdge& e, const std::vector<features::LineSegment>
     reach = std::max(reach, b);
   }
   return L > 0 ? covered / L : 0;
+}
+
+// A tilted bright bar on a 320x240 pair, the right image holding it `shift` px to the left; `skew`
+// shifts the right bar's bottom corners further, so disparity grows linearly down the bar. Its two
+// long slanted sides are the stereo lines.
+inline std::pair<cv::Mat, cv::Mat> make_bar_pair(float shift, float skew = 0) {
+  cv::Mat a(240, 320, CV_8U, cv::Scalar(50)), b(240, 320, CV_8U, cv::Scalar(50));
+  auto bar = [](cv::Mat& img, float top, float bottom) {
+    std::vector<cv::Point> p;
+    for (const cv::Point2f q : {cv::Point2f(120 - top, 30), cv::Point2f(170 - top, 30), cv::Point2f(210 - bottom, 210),
+                                cv::Point2f(160 - bottom, 210)})
+      p.emplace_back(cvRound(q.x * 16), cvRound(q.y * 16));
+    cv::fillConvexPoly(img, p, cv::Scalar(200), cv::LINE_AA, 4);
+  };
+  bar(a, 0, 0);
+  bar(b, shift, shift + skew);
+  return {a, b};
 }
 
 }  // namespace plslam::test

@@ -54,24 +54,8 @@ TEST(GuidedStereoLines, EndpointDepthWithinTwoPercentOnSyntheticScene) {
   EXPECT_EQ(steep_within, steep) << "lines at least 20 degrees from horizontal";
 }
 
-// A tilted bright bar, the right image holding it `shift` px to the left.
-std::pair<cv::Mat, cv::Mat> bar_pair(float shift, float skew = 0) {
-  cv::Mat a(240, 320, CV_8U, cv::Scalar(50)), b(240, 320, CV_8U, cv::Scalar(50));
-  // skew: extra shift of the bottom corners, so disparity grows linearly down the bar.
-  auto bar = [](cv::Mat& img, float top, float bottom) {
-    std::vector<cv::Point> p;
-    for (const cv::Point2f q : {cv::Point2f(120 - top, 30), cv::Point2f(170 - top, 30), cv::Point2f(210 - bottom, 210),
-                                cv::Point2f(160 - bottom, 210)})
-      p.emplace_back(cvRound(q.x * 16), cvRound(q.y * 16));
-    cv::fillConvexPoly(img, p, cv::Scalar(200), cv::LINE_AA, 4);
-  };
-  bar(a, 0, 0);
-  bar(b, shift, shift + skew);
-  return {a, b};
-}
-
 TEST(GuidedStereoLines, ConstructedPairGivesExactDisparities) {
-  const auto [a, b] = bar_pair(12);
+  const auto [a, b] = test::make_bar_pair(12);
   const StereoCalibration k{320, 240, 300, 300, 160, 120, 0.1};
   const auto fa = features::extract_lines(a);
   const auto m = match_stereo_lines_guided(fa, a, b, k);
@@ -85,7 +69,7 @@ TEST(GuidedStereoLines, ConstructedPairGivesExactDisparities) {
 
 TEST(GuidedStereoLines, DisparityVaryingAlongTheLineIsFollowed) {
   // The right bar's bottom is 6 px further left than its top: d = 10 at row 30, 16 at row 210.
-  const auto [a, b] = bar_pair(10, 6);
+  const auto [a, b] = test::make_bar_pair(10, 6);
   const StereoCalibration k{320, 240, 300, 300, 160, 120, 0.1};
   const auto fa = features::extract_lines(a);
   const auto m = match_stereo_lines_guided(fa, a, b, k);
@@ -116,7 +100,7 @@ TEST(GuidedStereoLines, RepeatedBarsAreRefusedNotGuessed) {
 }
 
 TEST(GuidedStereoLines, BadInputIsRefused) {
-  const auto [a, b] = bar_pair(12);
+  const auto [a, b] = test::make_bar_pair(12);
   const auto fa = features::extract_lines(a);
   const StereoCalibration k{320, 240, 300, 300, 160, 120, 0.1};
   EXPECT_THROW(match_stereo_lines_guided(fa, a, b(cv::Rect(0, 0, 100, 100)), k), std::invalid_argument);

@@ -78,15 +78,7 @@ TEST(StereoLines, LineCoefficientsAndRowIntersection) {
 
 TEST(StereoLines, ConstructedPairGivesExactDisparities) {
   // A tilted bright bar; the right image holds it 12 px to the left.
-  cv::Mat a(240, 320, CV_8U, cv::Scalar(50)), b(240, 320, CV_8U, cv::Scalar(50));
-  auto bar = [](cv::Mat& img, float dx) {
-    std::vector<cv::Point> p;
-    for (const cv::Point2f q : {cv::Point2f(120, 30), cv::Point2f(170, 30), cv::Point2f(210, 210), cv::Point2f(160, 210)})
-      p.emplace_back(cvRound((q.x - dx) * 16), cvRound(q.y * 16));
-    cv::fillConvexPoly(img, p, cv::Scalar(200), cv::LINE_AA, 4);
-  };
-  bar(a, 0);
-  bar(b, 12);
+  const auto [a, b] = test::make_bar_pair(12);
   const StereoCalibration k{320, 240, 300, 300, 160, 120, 0.1};
   const auto fa = features::extract_lines(a), fb = features::extract_lines(b);
   const auto m = match_stereo_lines(fa, fb, k);
