@@ -128,6 +128,9 @@ TEST(Map, ReplacingAPointMovesItsObservations) {
   b->add_map_point(q, 5);
   q->add_observation(c, 4);
   c->add_map_point(q, 4);
+  // The list holds what the map holds, in keyframe-id order.
+  const std::vector<std::pair<KeyFrame*, int>> before{{b, 5}, {c, 4}};
+  EXPECT_EQ(q->observation_list(), before);
   p->replace_with(q);
   EXPECT_TRUE(p->is_bad());
   EXPECT_EQ(p->replaced_by(), q);
@@ -135,6 +138,9 @@ TEST(Map, ReplacingAPointMovesItsObservations) {
   EXPECT_EQ(a->map_point(3), q);
   EXPECT_EQ(c->map_point(4), q);
   EXPECT_EQ(map.num_points(), 1u);
+  const std::vector<std::pair<KeyFrame*, int>> after{{a, 3}, {b, 5}, {c, 4}};
+  EXPECT_EQ(q->observation_list(), after);
+  EXPECT_TRUE(p->observation_list().empty());
 }
 
 TEST(Map, PointWithOneObservationLeftBecomesBad) {

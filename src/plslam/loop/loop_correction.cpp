@@ -20,7 +20,7 @@ KeyFrame* anchor_of(L* l, const IdMap<L, KeyFrame*>& corrected_by, const IdMap<K
   if (const auto it = corrected_by.find(l); it != corrected_by.end()) return it->second;
   KeyFrame* ref = l->reference();
   if (ref && !ref->is_bad() && poses.count(ref)) return ref;
-  for (const auto& [kf, idx] : l->observations()) {
+  for (const auto& [kf, idx] : l->observation_list()) {
     if (!kf->is_bad() && poses.count(kf)) return kf;
   }
   return nullptr;

@@ -14,6 +14,8 @@
 
 #include "plslam/map/by_id.h"
 #include <mutex>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -47,6 +49,9 @@ class Landmark {
   // Removes one; a landmark left with fewer than two observing keyframes turns bad.
   void erase_observation(KeyFrame* kf);
   IdMap<KeyFrame, int> observations() const;
+  // The same, in keyframe-id order, in one allocation rather than one tree node each: the local
+  // BA window and the landmark updates read thousands of landmarks per keyframe.
+  std::vector<std::pair<KeyFrame*, int>> observation_list() const;
   // Calls f(keyframe, index) for each observation under the landmark's lock, without the copy
   // observations() makes (the per-frame covisibility counts visit thousands of landmarks). f must
   // take no lock and must not call back into this landmark.

@@ -45,6 +45,12 @@ IdMap<KeyFrame, int> Landmark<D>::observations() const {
 }
 
 template <class D>
+std::vector<std::pair<KeyFrame*, int>> Landmark<D>::observation_list() const {
+  std::lock_guard lock(mutex_);
+  return {observations_.begin(), observations_.end()};
+}
+
+template <class D>
 int Landmark<D>::num_observations() const {
   std::lock_guard lock(mutex_);
   return static_cast<int>(observations_.size());
@@ -72,7 +78,7 @@ KeyFrame* Landmark<D>::reference() const {
 template <class D>
 void Landmark<D>::update_descriptor() {
   std::vector<cv::Mat> descs;
-  for (const auto& [kf, idx] : observations()) {
+  for (const auto& [kf, idx] : observation_list()) {
     if (!kf->is_bad()) descs.push_back(D::descriptor_row(*kf, idx));
   }
   cv::Mat best = most_distinctive(descs);

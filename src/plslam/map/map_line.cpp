@@ -54,7 +54,7 @@ bool MapLine::is_stereo(const KeyFrame& kf, int index) {
 }
 
 void MapLine::update_normal_and_depth() {
-  const auto obs = observations();
+  const auto obs = observation_list();
   KeyFrame* ref = reference();
   const Eigen::Vector3d m = midpoint();
   if (obs.empty() || !ref) return;
@@ -67,7 +67,7 @@ void MapLine::update_normal_and_depth() {
 bool MapLine::refit_to_observations() {
   const Eigen::Vector3d a = start(), b = end();
   const Eigen::Vector3d mid = 0.5 * (a + b);
-  const auto obs = observations();
+  const auto obs = observation_list();
   // 1. Direction: normal to every observed plane.
   Eigen::Matrix3d N = Eigen::Matrix3d::Zero();
   for (const auto& [kf, idx] : obs) {

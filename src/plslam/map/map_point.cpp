@@ -39,11 +39,11 @@ bool MapPoint::is_stereo(const KeyFrame& kf, int index) {
 }
 
 void MapPoint::update_normal_and_depth() {
-  const auto obs = observations();
+  const auto obs = observation_list();
   KeyFrame* ref = reference();
   const Eigen::Vector3d p = position();
   if (obs.empty() || !ref) return;
-  const auto ref_it = obs.find(ref);
+  const auto ref_it = std::find_if(obs.begin(), obs.end(), [ref](const auto& o) { return o.first == ref; });
   if (ref_it == obs.end()) return;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   for (const auto& [kf, idx] : obs) normal += (p - kf->camera_center()).normalized();

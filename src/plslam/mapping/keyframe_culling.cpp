@@ -15,7 +15,7 @@ bool is_redundant(const map::KeyFrame& k, const KeyframeCullingOptions& o) {
     if (mp->observation_weight() <= o.observers) continue;
     const int level = d.keypoints[i].octave;
     int seen = 0;
-    for (const auto& [other, idx] : mp->observations()) {
+    for (const auto& [other, idx] : mp->observation_list()) {
       if (other == &k || other->is_bad()) continue;
       if (other->data().keypoints[static_cast<std::size_t>(idx)].octave <= level + 1 && ++seen >= o.observers) break;
     }

@@ -32,7 +32,7 @@ void MapBaProblem::add_landmarks_of(const std::vector<map::KeyFrame*>& kfs) {
   }
   for (std::size_t p = first_point; p < points.size(); ++p) {
     problem.points.push_back({points[p]->position(), false});
-    for (const auto& [k, idx] : points[p]->observations()) {
+    for (const auto& [k, idx] : points[p]->observation_list()) {
       if (k->is_bad()) continue;
       const int ki = add_keyframe(k, true);
       const auto& d = k->data();
@@ -50,7 +50,7 @@ void MapBaProblem::add_landmarks_of(const std::vector<map::KeyFrame*>& kfs) {
   }
   for (std::size_t l = first_line; l < lines.size(); ++l) {
     problem.lines.push_back({lines[l]->start(), lines[l]->end(), false});
-    for (const auto& [k, idx] : lines[l]->observations()) {
+    for (const auto& [k, idx] : lines[l]->observation_list()) {
       if (k->is_bad()) continue;
       const int ki = add_keyframe(k, true);
       const auto& obs = k->data().lines[static_cast<std::size_t>(idx)];
