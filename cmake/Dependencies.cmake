@@ -10,6 +10,10 @@ find_package(spdlog REQUIRED)
 find_package(yaml-cpp REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(Threads REQUIRED)
+# libdeflate (libdeflate-dev): io/png_grey's fast path for the datasets' greyscale PNGs. Linked
+# by name, so the exported static library asks its users' linker for -ldeflate.
+find_library(PLSLAM_LIBDEFLATE NAMES deflate REQUIRED)
+find_path(PLSLAM_LIBDEFLATE_INCLUDE_DIR libdeflate.h REQUIRED)
 # cpp-httplib (libcpp-httplib-dev): Debian builds it as a shared library whose header must be
 # compiled with the same feature macros, which its pkg-config file gives. Only the viewer
 # (plslam_viz) links it.

@@ -38,5 +38,5 @@ set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 # The Python module is built for the distribution's python3 (3.11 on Debian 12).
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3 (>= 3.11), python3 (<< 3.12), python3-numpy")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
-  "libopencv-dev, libopencv-contrib-dev, libeigen3-dev, libceres-dev, libtbb-dev, libspdlog-dev, libfmt-dev, libyaml-cpp-dev, nlohmann-json3-dev, cmake")
+  "libopencv-dev, libopencv-contrib-dev, libeigen3-dev, libceres-dev, libtbb-dev, libspdlog-dev, libfmt-dev, libyaml-cpp-dev, nlohmann-json3-dev, libdeflate-dev, cmake")
 include(CPack)

@@ -8,7 +8,7 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev
   libeigen3-dev libceres-dev libtbb-dev
   libcli11-dev libspdlog-dev libfmt-dev libyaml-cpp-dev
-  nlohmann-json3-dev libcpp-httplib-dev
+  nlohmann-json3-dev libcpp-httplib-dev libdeflate-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   pybind11-dev python3-dev python3-numpy python3-pytest dpkg-dev
   chromium
