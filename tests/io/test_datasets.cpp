@@ -184,7 +184,7 @@ const BadInput kBadInputs[] = {
      [](const fs::path& r) {
        return kitti_with(r, [](const fs::path& s) { test::write_file(s / "image_0" / "000000.png", "not a png"); });
      },
-     "000000.png", "corrupt or truncated image"},
+     "000000.png", "not a PNG, JPEG, PGM/PPM, BMP or TIFF image"},
     {"kitti_truncated_png",
      [](const fs::path& r) {
        return kitti_with(r, [](const fs::path& s) {

@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <fstream>
+#include <initializer_list>
 #include <vector>
 
 #include <fmt/format.h>
@@ -44,6 +45,23 @@ std::string raw_pnm_size_problem(const std::vector<uchar>& bytes) {
   return "";
 }
 
+// The formats the dataset readers take (kitti_dataset.cpp's extensions), told by their first
+// bytes. cv::imdecode would try every codec OpenCV was built with, and some abort the process on
+// bad input: GDCM asserts on a damaged DICOM file (found by fuzzing,
+// tests/fuzz/corpus/image/dicom_assert_in_gdcm).
+bool is_supported_format(const std::vector<uchar>& b) {
+  auto starts = [&](std::initializer_list<int> magic) {
+    if (b.size() < magic.size()) return false;
+    std::size_t i = 0;
+    for (const int m : magic)
+      if (b[i++] != m) return false;
+    return true;
+  };
+  return starts({0x89, 'P', 'N', 'G'}) || starts({0xff, 0xd8, 0xff}) || starts({'B', 'M'}) ||
+         starts({'I', 'I', 42, 0}) || starts({'M', 'M', 0, 42}) ||
+         (b.size() >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6');  // PBM, PGM, PPM
+}
+
 }  // namespace
 
 cv::Mat load_grey_image(const std::filesystem::path& path) {
@@ -63,6 +81,8 @@ cv::Mat load_grey_image(const std::filesystem::path& path) {
   if (bytes.empty()) throw InputError(path.string(), "empty image file");
   // imdecode returns an empty Mat (and libpng may print a warning) for corrupt or truncated data.
   if (const auto problem = raw_pnm_size_problem(bytes); !problem.empty()) throw InputError(path.string(), problem);
+  if (!is_supported_format(bytes))
+    throw InputError(path.string(), "not a PNG, JPEG, PGM/PPM, BMP or TIFF image");
   if (auto grey = decode_grey8_png(bytes)) return std::move(*grey);
   cv::Mat img;
   try {
