@@ -45,10 +45,11 @@ std::string raw_pnm_size_problem(const std::vector<uchar>& bytes) {
   return "";
 }
 
-// The formats the dataset readers take (kitti_dataset.cpp's extensions), told by their first
-// bytes. cv::imdecode would try every codec OpenCV was built with, and some abort the process on
-// bad input: GDCM asserts on a damaged DICOM file (found by fuzzing,
-// tests/fuzz/corpus/image/dicom_assert_in_gdcm).
+// The formats the dataset readers take (kitti_dataset.cpp's extensions), told by the same
+// signatures OpenCV's own decoders check, which it tries before any other: so cv::imdecode picks
+// one of them. Otherwise it would try every codec OpenCV was built with, and GDCM asserts (aborts
+// the process) on a damaged DICOM file, or allocates what its header says (4 GB): found by
+// fuzzing, tests/fuzz/corpus/image/dicom_assert_in_gdcm and dicom_after_png_magic_4gb.
 bool is_supported_format(const std::vector<uchar>& b) {
   auto starts = [&](std::initializer_list<int> magic) {
     if (b.size() < magic.size()) return false;
@@ -57,9 +58,9 @@ bool is_supported_format(const std::vector<uchar>& b) {
       if (b[i++] != m) return false;
     return true;
   };
-  return starts({0x89, 'P', 'N', 'G'}) || starts({0xff, 0xd8, 0xff}) || starts({'B', 'M'}) ||
+  return starts({0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'}) || starts({0xff, 0xd8, 0xff}) || starts({'B', 'M'}) ||
          starts({'I', 'I', 42, 0}) || starts({'M', 'M', 0, 42}) ||
-         (b.size() >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6');  // PBM, PGM, PPM
+         (b.size() >= 3 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6' && std::isspace(b[2]));  // PBM, PGM, PPM
 }
 
 }  // namespace
