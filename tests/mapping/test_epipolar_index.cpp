@@ -45,7 +45,7 @@ void check_motion(const Eigen::Vector3d& motion, double noise, std::mt19937& rng
     x1.push_back(p1);
     x2.push_back(p2 + noise * std::abs(unit(rng)) * Eigen::Vector2d(std::cos(a), std::sin(a)));
   }
-  const EpipolarIndex index(x2, g.K * g.t21);
+  const EpipolarIndex index(x2, g.K * g.t21, noise + 1e-9);
   const Eigen::Matrix3d H = g.K * g.R21 * g.K.inverse();
   std::vector<int> out;
   double returned = 0;
@@ -53,7 +53,7 @@ void check_motion(const Eigen::Vector3d& motion, double noise, std::mt19937& rng
     EpipolarIndex::Ray ray;
     const Eigen::Vector3d v = H * Eigen::Vector3d(x1[static_cast<std::size_t>(i)].x(), x1[static_cast<std::size_t>(i)].y(), 1.0);
     if (index.ray(v, &ray)) {
-      index.query(ray, noise + 1e-9, &out);
+      index.query(ray, &out);
     } else {
       index.query_all(&out);
     }
@@ -93,7 +93,7 @@ TEST(EpipolarIndex, ForwardMotionReadsAFewPercent) {
 
 TEST(EpipolarIndex, EpipoleAtInfinityReturnsAll) {
   const std::vector<Eigen::Vector2d> points = {{1, 2}, {300, 40}, {10, 10}};
-  const EpipolarIndex index(points, {1.0, 0.0, 0.0});
+  const EpipolarIndex index(points, {1.0, 0.0, 0.0}, 3.0);
   EpipolarIndex::Ray ray;
   EXPECT_FALSE(index.ray({100, 100, 1}, &ray));
   std::vector<int> out;
@@ -102,11 +102,11 @@ TEST(EpipolarIndex, EpipoleAtInfinityReturnsAll) {
 }
 
 TEST(EpipolarIndex, EmptyIndexReturnsNothing) {
-  const EpipolarIndex empty({}, {100, 100, 1});
+  const EpipolarIndex empty({}, {100, 100, 1}, 3.0);
   EpipolarIndex::Ray ray;
   ASSERT_TRUE(empty.ray({300, 120, 1}, &ray));
   std::vector<int> out{5};
-  empty.query(ray, 3.0, &out);
+  empty.query(ray, &out);
   EXPECT_TRUE(out.empty());
 }
 

@@ -20,8 +20,8 @@ int EpipolarIndex::ring_of(double rho) {
   return std::min(k, kMaxRings - 1);
 }
 
-EpipolarIndex::EpipolarIndex(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& epipole)
-    : epipole_h_(epipole), size_(static_cast<int>(points.size())) {
+EpipolarIndex::EpipolarIndex(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& epipole, double band)
+    : epipole_h_(epipole), band_(band), size_(static_cast<int>(points.size())) {
   const double w = epipole.z(), scale = epipole.head<2>().norm();
   // An epipole further than ~1e15 px is numerically at infinity: directions from it are all equal.
   finite_ = std::isfinite(w) && std::isfinite(scale) && std::abs(w) > 1e-15 * scale;
@@ -30,6 +30,12 @@ EpipolarIndex::EpipolarIndex(const std::vector<Eigen::Vector2d>& points, const E
   rings_.resize(kMaxRings);
   inner_.assign(kMaxRings, 0.0);
   for (int k = 1; k < kMaxRings; ++k) inner_[static_cast<std::size_t>(k)] = kInnerRadius * std::pow(kRingRatio, k - 1);
+  // A point at distance rho >= inner within `band` of the half-line deviates in angle by at most
+  // asin(band / rho); a small margin covers the rounding of the stored angles. From half the
+  // inner radius on (asin(1/2) = 30 deg) the whole ring is read.
+  window_.assign(kMaxRings, -1.0);
+  for (std::size_t k = 0; k < window_.size(); ++k)
+    if (band < 0.5 * inner_[k]) window_[k] = std::asin(band / inner_[k]) + 1e-12;
   for (int i = 0; i < size_; ++i) {
     const Eigen::Vector2d d = points[static_cast<std::size_t>(i)] - epipole_;
     rings_[static_cast<std::size_t>(ring_of(d.norm()))].push_back({std::atan2(d.y(), d.x()), i});
@@ -48,6 +54,7 @@ bool EpipolarIndex::ray(const Eigen::Vector3d& v, Ray* out) const {
   const double n = d.norm();
   if (!(n > 0) || !std::isfinite(n)) return false;  // the ray runs along the baseline
   out->direction = d / n;
+  out->angle = std::atan2(out->direction.y(), out->direction.x());
   // |x(z) - e2| = z |d| / (z v_w + e_w): with e_w, v_w > 0 it grows from 0 towards |d| / v_w, the
   // distance to the vanishing point; otherwise it is unbounded.
   out->length = std::numeric_limits<double>::infinity();
@@ -60,25 +67,22 @@ void EpipolarIndex::query_all(std::vector<int>* out) const {
   for (int i = 0; i < size_; ++i) (*out)[static_cast<std::size_t>(i)] = i;
 }
 
-void EpipolarIndex::query(const Ray& ray, double band, std::vector<int>* out) const {
+void EpipolarIndex::query(const Ray& ray, std::vector<int>* out) const {
   out->clear();
   if (!finite_) {
     query_all(out);
     return;
   }
-  const double theta = std::atan2(ray.direction.y(), ray.direction.x());
+  const double theta = ray.angle;
   for (std::size_t k = 0; k < rings_.size(); ++k) {
-    const double inner = inner_[k];
-    if (inner > ray.length + band) break;  // beyond the vanishing point
+    if (inner_[k] > ray.length + band_) break;  // beyond the vanishing point
     const auto& ring = rings_[k];
     if (ring.empty()) continue;
-    // A point at distance rho >= inner within `band` of the half-line deviates in angle by at
-    // most asin(band / rho); a small margin covers the rounding of the stored angles.
-    if (band >= 0.5 * inner) {  // wide window (asin(1/2) = 30 deg): read the whole ring
+    const double window = window_[k];
+    if (window < 0) {  // wide window: the whole ring
       for (const auto& e : ring) out->push_back(e.index);
       continue;
     }
-    const double window = std::asin(band / inner) + 1e-12;
     auto read = [&](double lo, double hi) {  // angles in [lo, hi], within (-pi, pi]
       auto it = std::lower_bound(ring.begin(), ring.end(), lo, [](const Entry& e, double a) { return e.angle < a; });
       for (; it != ring.end() && it->angle <= hi; ++it) out->push_back(it->index);

@@ -17,15 +17,17 @@ namespace plslam::mapping {
 class EpipolarIndex {
  public:
   // `points`: image-2 positions (pixels); `epipole`: e2 in homogeneous image coordinates (the
-  // projection of camera 1's centre into camera 2, K t_21). With the epipole at infinity (pure
-  // sideways motion) queries fall back to returning every point.
-  EpipolarIndex(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& epipole);
+  // projection of camera 1's centre into camera 2, K t_21); `band`: the half-width in pixels
+  // every query reads around its segment, fixed so each ring's angular window is computed once.
+  // With the epipole at infinity (pure sideways motion) queries fall back to returning every point.
+  EpipolarIndex(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector3d& epipole, double band);
 
   // The image-2 segment of the ray whose projection is x(z) = z v + e2 (homogeneous) for depths
   // z > 0: v = K R_21 K^-1 x1 for the keypoint x1 of image 1. Returns false when the ray has no
   // such segment (degenerate geometry: the caller should use query_all).
   struct Ray {
     Eigen::Vector2d direction;  // from the epipole, unit length
+    double angle;               // of the direction, in (-pi, pi]
     double length;              // distance from the epipole to the vanishing point (inf: none)
   };
   bool ray(const Eigen::Vector3d& v, Ray* out) const;
@@ -33,7 +35,7 @@ class EpipolarIndex {
   // Indices (into `points`) of every point within `band` pixels of the ray's segment, and
   // possibly a few more; the caller applies its exact test. No duplicates, in no particular order
   // (callers break ties by index).
-  void query(const Ray& ray, double band, std::vector<int>* out) const;
+  void query(const Ray& ray, std::vector<int>* out) const;
   void query_all(std::vector<int>* out) const;
 
  private:
@@ -48,6 +50,8 @@ class EpipolarIndex {
   Eigen::Vector2d epipole_ = Eigen::Vector2d::Zero();
   std::vector<std::vector<Entry>> rings_;  // ring k: rho in [r0 2^(k-1), r0 2^k), ring 0: rho < r0
   std::vector<double> inner_;              // inner radius of each ring
+  double band_ = 0;
+  std::vector<double> window_;             // each ring's angular half-window for band_ (< 0: whole ring)
   int size_ = 0;
 };
 

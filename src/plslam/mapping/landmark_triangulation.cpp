@@ -49,10 +49,9 @@ void triangulate_points(map::Map& map, map::KeyFrame& kf1, map::KeyFrame& kf2,
     free2_position[level].emplace_back(d2.keypoints[j].pt.x, d2.keypoints[j].pt.y);
   }
   std::vector<EpipolarIndex> index;
-  std::vector<double> band;  // the epipolar test's gate below, plus rounding
   for (std::size_t l = 0; l < free2.size(); ++l) {
-    index.emplace_back(free2_position[l], epipole);
-    band.push_back(std::sqrt(kChi2Epipolar * d2.level_sigma2(static_cast<int>(l))) + 1e-6);
+    // The epipolar test's gate below, plus rounding.
+    index.emplace_back(free2_position[l], epipole, std::sqrt(kChi2Epipolar * d2.level_sigma2(static_cast<int>(l))) + 1e-6);
   }
   std::vector<int> candidates;
   std::vector<bool> used2(points2.size(), false);
@@ -68,7 +67,7 @@ void triangulate_points(map::Map& map, map::KeyFrame& kf1, map::KeyFrame& kf2,
     for (std::size_t l = 0; l < index.size(); ++l) {
       if (free2[l].empty()) continue;
       if (has_ray) {
-        index[l].query(ray, band[l], &candidates);
+        index[l].query(ray, &candidates);
       } else {
         index[l].query_all(&candidates);
       }
