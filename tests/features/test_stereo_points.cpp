@@ -82,6 +82,30 @@ TEST(StereoPoints, SubPixelDisparityErrorIsSmallAtLevelZero) {
   EXPECT_LT(err[err.size() * 95 / 100], 0.2);
 }
 
+// Other SAD windows and search ranges than the default (9x9 over 19 shifts, 5x5 over 3, 15x15
+// over 9) keep the sub-pixel accuracy of the default.
+TEST(StereoPoints, OtherSadWindowsAndSearchRangesStayAccurate) {
+  const double bf = 400.0, d = 33.37;
+  const auto scene = test::synthetic_plane_stereo(cv::Size(640, 480), bf, {bf / d}, 5);
+  const features::OrbExtractor ex;
+  for (const auto& [hw, search] : {std::pair{4, 9}, std::pair{2, 1}, std::pair{7, 4}, std::pair{5, 5}}) {
+    StereoPointOptions so;
+    so.bf = bf;
+    so.baseline = 0.5;
+    so.sad_half_window = hw;
+    so.sad_search = search;
+    const StereoPointFrame f = extract_stereo_points(ex, ex, scene.left, scene.right, so);
+    std::vector<double> err;
+    for (std::size_t i = 0; i < f.left.keypoints.size(); ++i)
+      if (f.stereo.depth[i] > 0 && f.left.keypoints[i].octave == 0)
+        err.push_back(std::abs(f.left.keypoints[i].pt.x - f.stereo.u_right[i] - d));
+    ASSERT_GT(err.size(), 100u) << "window " << hw << " search " << search;
+    std::sort(err.begin(), err.end());
+    EXPECT_LT(err[err.size() / 2], 0.1) << "window " << hw << " search " << search;
+    EXPECT_LT(err[err.size() * 95 / 100], 0.25) << "window " << hw << " search " << search;
+  }
+}
+
 // Pixel locking: a sub-pixel fit that does not match the SAD curve's shape pulls disparities to
 // whole pixels, most at fractions 0.2 and 0.8 (the parabola: -0.10 and +0.10 px mean error at
 // level 0 on these planes, 0.10 px mean absolute error; the equiangular fit: -0.03, +0.03, 0.03).
