@@ -232,11 +232,16 @@ Fit evaluate(std::vector<Sample>& samples, const RowSearch& search, double alpha
   return f;
 }
 
-// Least squares over the rows that agree with f, then the checks on the result; the endpoint
-// disparities, or nothing.
-std::optional<std::pair<double, double>> refine(std::vector<Sample>& samples, const RowSearch& search, const Fit& f,
-                                                const features::LineSegment& a, int needed, double max_disp,
-                                                const GuidedStereoLineOptions& o) {
+struct Refined {
+  double d_start, d_end;  // endpoint disparities
+  int inliers;            // rows that agree with the refitted disparity
+};
+
+// Least squares over the rows that agree with f, then the checks on the result (at least `needed`
+// rows agree with the refit); or nothing.
+std::optional<Refined> refine(std::vector<Sample>& samples, const RowSearch& search, const Fit& f,
+                              const features::LineSegment& a, int needed, double max_disp,
+                              const GuidedStereoLineOptions& o) {
   std::vector<RowCandidate> chosen;
   evaluate(samples, search, f.alpha, f.beta, o.inlier_px, &chosen);
   double sw = 0, sy = 0, sd = 0, syy = 0, syd = 0;
@@ -253,11 +258,12 @@ std::optional<std::pair<double, double>> refine(std::vector<Sample>& samples, co
   const double var = syy - sy * sy / sw;
   const double beta = var > 1e-6 ? (syd - sy * sd / sw) / var : 0.0;
   const double alpha = (sd - beta * sy) / sw;
-  if (evaluate(samples, search, alpha, beta, o.inlier_px).inliers < needed) return std::nullopt;
+  const int inliers = evaluate(samples, search, alpha, beta, o.inlier_px).inliers;
+  if (inliers < needed) return std::nullopt;
   const double ds = alpha + beta * a.start.y, de = alpha + beta * a.end.y;
   if (!(ds > 0 && de > 0 && ds <= max_disp && de <= max_disp)) return std::nullopt;
   if (std::fabs(de - ds) > o.max_disparity_slope * a.length()) return std::nullopt;
-  return std::make_pair(ds, de);
+  return Refined{ds, de, inliers};
 }
 
 // Most rows explained by a fit whose middle-row disparity differs from `mid` (0 if none).
@@ -367,20 +373,22 @@ std::vector<StereoLineMatch> match_stereo_lines_guided(const features::LineFeatu
     const double y_mid = 0.5 * (a.start.y + a.end.y);
     std::vector<std::pair<double, double>> options;  // endpoint disparities
     std::vector<double> mids;
-    bool first_refined = false;  // options[0] is the best fit's
+    // Every explanation is refined with the relaxed share. The best one keeps the strict share
+    // through its refit, or the descriptor decides among all of them, the best included.
+    bool first_strict = false;  // options[0] is the best fit's, with the strict share after its refit
     for (const Fit& f : fits) {
       if (f.inliers < relaxed || static_cast<int>(options.size()) >= o.lbd_candidates) break;
       const double mid = f.alpha + f.beta * y_mid;
       if (std::any_of(mids.begin(), mids.end(), [&](double x) { return std::fabs(x - mid) <= 2 * o.inlier_px; }))
         continue;
       mids.push_back(mid);
-      const auto d = refine(samples, search, f, a, &f == &fits[0] ? needed : relaxed, max_disp, o);
-      if (d) options.push_back(*d);
-      first_refined = first_refined || (d && &f == &fits[0]);
+      const auto d = refine(samples, search, f, a, relaxed, max_disp, o);
+      if (d) options.emplace_back(d->d_start, d->d_end);
+      if (d && &f == &fits[0]) first_strict = d->inliers >= needed;
     }
     if (options.empty()) continue;
     // The rows decide alone when one explanation has the strict share and no other as many rows.
-    if (first_refined && fits[0].inliers >= needed &&
+    if (first_strict && fits[0].inliers >= needed &&
         fits[0].inliers > second_inliers(fits, mids[0], y_mid, o.inlier_px)) {
       out.push_back(make_stereo_line_match(i, -1, 0, a, options[0].first, options[0].second, calib));
       continue;
