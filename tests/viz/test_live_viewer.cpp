@@ -10,6 +10,7 @@
 #include <set>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -41,7 +42,7 @@ map::MapSnapshot two_keyframes() {
 TEST(SceneDelta, HoldsWhatWasAddedMovedAndRemovedAndNothingElse) {
   const auto before = two_keyframes();
   auto after = before;
-  after.points[0].position.z() += 0.0005;  // below 1 mm: not sent
+  after.points[0].position.z() += 0.0005;  // below the threshold: not sent
   after.points[1].position.z() += 0.01;    // moved
   after.points.erase(after.points.begin() + 2);  // point 3 culled
   after.points.push_back({4, {1, 1, 1}});  // new
@@ -87,6 +88,38 @@ TEST(SceneDelta, HoldsWhatWasAddedMovedAndRemovedAndNothingElse) {
   const json whole = scene_delta(after, after, info, std::nullopt, 7);
   EXPECT_EQ(whole["trajectory"].size(), 9u);
   EXPECT_FALSE(whole.contains("trajectory_append"));
+}
+
+// Landmarks and keyframes are compared with where the page has them, not with the last snapshot:
+// moves below the threshold add up until one is sent, so the page never drifts from the map by
+// more than the threshold. Numbers go out rounded to a tenth of a millimetre, in few digits.
+TEST(SceneDelta, SmallMovesAddUpUntilTheyAreSentAndNumbersAreShort) {
+  const auto page = two_keyframes();
+  const SceneInfo info;
+  const double step = 0.6 * kPageMinMove;
+  auto after = page;
+  after.points[0].position.z() += step;
+  after.keyframes[1].T_wc = geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1 + step, 0, 0));
+  map::MapSnapshot page_after;
+  const json first = scene_delta(page, after, info, 0, 1, kPageMinMove, &page_after);
+  EXPECT_TRUE(first["points"]["ids"].empty());
+  EXPECT_TRUE(first["keyframes"]["ids"].empty());
+  EXPECT_EQ(page_after.points[0].position, page.points[0].position);  // the page keeps its copy
+  EXPECT_EQ(page_after.keyframes[1].T_wc.translation(), page.keyframes[1].T_wc.translation());
+
+  // Another step: each is below the threshold, the sum is above it.
+  auto later = after;
+  later.points[0].position.z() += step;
+  later.points[1].position = {1.23456789, -0.000012, 2};  // moved far: sent, and shows the rounding
+  later.keyframes[1].T_wc = geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(1 + 2 * step, 0, 0));
+  map::MapSnapshot page_later;
+  const json second = scene_delta(page_after, later, info, 0, 2, kPageMinMove, &page_later);
+  EXPECT_EQ(second["points"]["ids"], json({1, 2}));
+  EXPECT_EQ(second["keyframes"]["ids"], json({1}));
+  EXPECT_EQ(page_later.points[0].position, later.points[0].position);
+  EXPECT_EQ(second["points"]["xyz"].dump(), fmt::format("[0.0,0.0,{},1.2346,-0.0,2.0]", 1 + 2 * step));
+  // Compared with the snapshot before it, the second step alone would not have been sent.
+  EXPECT_EQ(scene_delta(after, later, info, 0, 2)["points"]["ids"], json({2}));
 }
 
 // Centres move with their keyframes; the page gets the new tail, or the whole trail once a centre

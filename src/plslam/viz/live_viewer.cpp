@@ -1,5 +1,7 @@
 #include "plslam/viz/live_viewer.h"
 
+#include <tuple>
+#include <utility>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -14,19 +16,12 @@ namespace {
 
 using nlohmann::json;
 
-void append(json& flat, const Eigen::Vector3d& p) {
-  for (int i = 0; i < 3; ++i) flat.push_back(static_cast<float>(p[i]));
-}
-
 // The keyframe arrays of the document, for the given keyframes.
 json keyframe_arrays(const std::vector<const map::KeyframeSnapshot*>& keyframes) {
   json ids = json::array(), poses = json::array(), parents = json::array();
   for (const auto* kf : keyframes) {
     ids.push_back(kf->id);
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) poses.push_back(static_cast<float>(kf->T_wc.rotation()(r, c)));
-      poses.push_back(static_cast<float>(kf->T_wc.translation()[r]));
-    }
+    for (auto& v : page_pose(kf->T_wc)) poses.push_back(std::move(v));
     parents.push_back(kf->parent);
   }
   return {{"ids", ids}, {"poses", poses}, {"parents", parents}};
@@ -84,18 +79,26 @@ void LiveTrail::sent(bool whole) {
   page_.insert(page_.end(), centres_.begin() + static_cast<std::ptrdiff_t>(page_.size()), centres_.end());
 }
 
-json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, const SceneInfo& info,
-                 std::optional<std::size_t> trail_sent, long revision, double min_move_m) {
+json scene_delta(const map::MapSnapshot& page, const map::MapSnapshot& after, const SceneInfo& info,
+                 std::optional<std::size_t> trail_sent, long revision, double min_move_m,
+                 map::MapSnapshot* page_after) {
+  // What the page will hold: `after`, with the unsent keyframes and landmarks where the page has
+  // them. Filled in below when asked for.
+  if (page_after) *page_after = after;
+
   // Keyframes: upserted when new or moved; the graph is resent whole when any keyframe changed
   // (a few thousand edges at most).
   std::unordered_map<long, const map::KeyframeSnapshot*> old_kfs;
-  for (const auto& kf : before.keyframes) old_kfs.emplace(kf.id, &kf);
+  for (const auto& kf : page.keyframes) old_kfs.emplace(kf.id, &kf);
   std::vector<const map::KeyframeSnapshot*> changed_kfs;
-  bool graph_changed = before.keyframes.size() != after.keyframes.size();
-  for (const auto& kf : after.keyframes) {
+  bool graph_changed = page.keyframes.size() != after.keyframes.size();
+  for (std::size_t i = 0; i < after.keyframes.size(); ++i) {
+    const auto& kf = after.keyframes[i];
     const auto it = old_kfs.find(kf.id);
     if (it == old_kfs.end() || !same_pose(it->second->T_wc, kf.T_wc, min_move_m) || it->second->parent != kf.parent) {
       changed_kfs.push_back(&kf);
+    } else if (page_after) {
+      page_after->keyframes[i].T_wc = it->second->T_wc;
     }
     if (it == old_kfs.end() || it->second->loop_edges != kf.loop_edges ||
         it->second->covisibility != kf.covisibility) {
@@ -107,14 +110,17 @@ json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, 
   for (const auto& [id, kf] : old_kfs) removed_kfs.push_back(id);
 
   std::unordered_map<long, Eigen::Vector3d> old_points;
-  old_points.reserve(before.points.size());
-  for (const auto& p : before.points) old_points.emplace(p.id, p.position);
+  old_points.reserve(page.points.size());
+  for (const auto& p : page.points) old_points.emplace(p.id, p.position);
   json point_ids = json::array(), point_xyz = json::array();
-  for (const auto& p : after.points) {
+  for (std::size_t i = 0; i < after.points.size(); ++i) {
+    const auto& p = after.points[i];
     const auto it = old_points.find(p.id);
     if (it == old_points.end() || (it->second - p.position).norm() > min_move_m) {
       point_ids.push_back(p.id);
-      append(point_xyz, p.position);
+      append_page_position(point_xyz, p.position);
+    } else if (page_after) {
+      page_after->points[i].position = it->second;
     }
     if (it != old_points.end()) old_points.erase(it);
   }
@@ -122,15 +128,18 @@ json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, 
   for (const auto& [id, p] : old_points) removed_points.push_back(id);
 
   std::unordered_map<long, std::pair<Eigen::Vector3d, Eigen::Vector3d>> old_lines;
-  for (const auto& l : before.lines) old_lines.emplace(l.id, std::make_pair(l.start, l.end));
+  for (const auto& l : page.lines) old_lines.emplace(l.id, std::make_pair(l.start, l.end));
   json line_ids = json::array(), line_xyz = json::array();
-  for (const auto& l : after.lines) {
+  for (std::size_t i = 0; i < after.lines.size(); ++i) {
+    const auto& l = after.lines[i];
     const auto it = old_lines.find(l.id);
     if (it == old_lines.end() || (it->second.first - l.start).norm() > min_move_m ||
         (it->second.second - l.end).norm() > min_move_m) {
       line_ids.push_back(l.id);
-      append(line_xyz, l.start);
-      append(line_xyz, l.end);
+      append_page_position(line_xyz, l.start);
+      append_page_position(line_xyz, l.end);
+    } else if (page_after) {
+      std::tie(page_after->lines[i].start, page_after->lines[i].end) = it->second;
     }
     if (it != old_lines.end()) old_lines.erase(it);
   }
@@ -140,7 +149,9 @@ json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, 
   // Only what changes per update: the trajectory gains its new tail, and the graph is built only
   // when it changed (building the whole document here cost a full serialisation per update).
   json trail = json::array();
-  for (std::size_t i = trail_sent.value_or(0); i < info.trajectory.size(); ++i) append(trail, info.trajectory[i]);
+  for (std::size_t i = trail_sent.value_or(0); i < info.trajectory.size(); ++i) {
+    append_page_position(trail, info.trajectory[i]);
+  }
   json d = {{"revision", revision},
             {"final", info.final},
             {"counts", scene_counts(after, info)},
@@ -205,11 +216,12 @@ void LiveViewer::publish_loop() {
 }
 
 void LiveViewer::publish_once() {
-  std::optional<LiveFrame> frame;
+  std::optional<LiveFrame> frame;  // the last one; it may be one already published
+  bool fresh = false;
   {
     std::lock_guard lock(frame_mutex_);
     if (!new_frame_ && map_.changes() == last_changes_) return;  // nothing to tell
-    new_frame_ = false;
+    fresh = std::exchange(new_frame_, false);
     frame = frame_;
   }
   last_changes_ = map_.changes();
@@ -218,7 +230,7 @@ void LiveViewer::publish_once() {
   auto& info = scene->info;
   info = base_;
   if (frame) {
-    if (frame->tracked) trail_.add(frame->anchor_keyframe, frame->centre_in_anchor, frame->T_wc.translation());
+    if (fresh && frame->tracked) trail_.add(frame->anchor_keyframe, frame->centre_in_anchor, frame->T_wc.translation());
     info.frame = frame->frame;
     info.frames = frame->frames;
     info.tracked = frame->tracked_frames;
@@ -232,12 +244,18 @@ void LiveViewer::publish_once() {
   const bool resend_trail = trail_.update(scene->map);
   info.trajectory = trail_.centres();
   // The camera image at half the update rate: encoding costs a few ms of this thread.
-  if (frame && !frame->left.empty() && image_updates_++ % 2 == 0) server_.publish_image(annotated_jpeg(*frame));
+  if (fresh && !frame->left.empty() && image_updates_++ % 2 == 0) server_.publish_image(annotated_jpeg(*frame));
   const long revision = revision_.load() + 1;
   info.revision = revision;
-  const auto delta =
-      scene_delta(last_->map, scene->map, info, resend_trail ? std::nullopt : std::optional(trail_.page_size()), revision)
-          .dump();
+  map::MapSnapshot page_after;
+  auto delta_json = scene_delta(page_, scene->map, info,
+                                resend_trail ? std::nullopt : std::optional(trail_.page_size()), revision,
+                                kPageMinMove, &page_after);
+  // The local map's ids (thousands) change with keyframes, not with every update: the page keeps
+  // the last ones it got.
+  if (info.local_map == last_->info.local_map) delta_json.erase("local_map");
+  const auto delta = delta_json.dump();
+  page_ = std::move(page_after);
   trail_.sent(resend_trail);
   last_ = scene;
   server_.publish(revision, [scene] { return scene_document(scene->map, scene->info).dump(); }, delta);

@@ -116,6 +116,7 @@ class LiveViewer {
 
   // Publisher thread state.
   std::shared_ptr<const Scene> last_;  // the state of the last revision
+  map::MapSnapshot page_;              // what a page that applied every delta holds
   long image_updates_ = 0;
   long last_changes_ = -1;
   std::atomic<long> revision_{0};
@@ -126,12 +127,21 @@ class LiveViewer {
   std::thread thread_;
 };
 
-// The change from `before` to `after` as the page applies it: upserted and removed keyframes,
-// points and lines (a landmark counts as changed when it moved by more than `min_move_m`), the
-// graph, counts, camera, local map, and of the trajectory the points after the first
-// `trail_sent` ("trajectory_append"), or all of it ("trajectory", replacing the page's) when
-// `trail_sent` is empty.
-nlohmann::json scene_delta(const map::MapSnapshot& before, const map::MapSnapshot& after, const SceneInfo& info,
-                           std::optional<std::size_t> trail_sent, long revision, double min_move_m = 1e-3);
+// How far a keyframe or landmark must move from where the page has it to be sent again. Local BA
+// moves thousands of points by a few millimetres every second; resent at 1 mm they were most of
+// each delta. 5 mm is under a pixel of a room-sized map fitted to the page, and the final
+// revision has every position exact.
+inline constexpr double kPageMinMove = 5e-3;
+
+// The change from `page` (what the page holds) to `after` as the page applies it: upserted and
+// removed keyframes, points and lines (a keyframe or landmark counts as changed when it is more
+// than `min_move_m` from where the page has it), the graph, counts, camera, local map, and of the
+// trajectory the points after the first `trail_sent` ("trajectory_append"), or all of it
+// ("trajectory", replacing the page's) when `trail_sent` is empty.
+// `page_after`, when given, receives what the page holds once it applied the delta: `after`, but
+// with what was not sent where the page has it, so that small moves add up until one is sent.
+nlohmann::json scene_delta(const map::MapSnapshot& page, const map::MapSnapshot& after, const SceneInfo& info,
+                           std::optional<std::size_t> trail_sent, long revision, double min_move_m = kPageMinMove,
+                           map::MapSnapshot* page_after = nullptr);
 
 }  // namespace plslam::viz

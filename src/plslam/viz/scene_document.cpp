@@ -24,12 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Positions go out as floats: a tenth of a millimetre is far below what the page can show, and
-// the document of a 100k-point map is half the size with 9 digits instead of 17.
-void append(json& flat, const Eigen::Vector3d& p) {
-  for (int i = 0; i < 3; ++i) flat.push_back(static_cast<float>(p[i]));
-}
-
+// map_graph.json's poses: floats, as the other outputs of a run.
 json pose_row_major(const geometry::SE3& T) {
   json out = json::array();
   for (int r = 0; r < 3; ++r) {
@@ -99,6 +94,28 @@ void add_ground_truth(const json& stats, SceneInfo& info, const Trajectory& esti
 }
 
 }  // namespace
+
+namespace {
+
+// `v` rounded to `1 / scale` (scale a power of ten). Dividing the whole number by the exact scale
+// gives the double nearest to the short decimal, which nlohmann::json prints in that many digits;
+// multiplying by 1e-4 instead would often give its neighbour, printed in 17.
+double rounded(double v, double scale) { return std::round(v * scale) / scale; }
+
+}  // namespace
+
+void append_page_position(json& flat, const Eigen::Vector3d& p) {
+  for (int i = 0; i < 3; ++i) flat.push_back(rounded(p[i], 1e4));
+}
+
+json page_pose(const geometry::SE3& T_wc) {
+  json out = json::array();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out.push_back(rounded(T_wc.rotation()(r, c), 1e6));
+    out.push_back(rounded(T_wc.translation()[r], 1e4));
+  }
+  return out;
+}
 
 json map_graph_json(const map::MapSnapshot& map) {
   json keyframes = json::array();
@@ -202,7 +219,7 @@ json scene_counts(const map::MapSnapshot& map, const SceneInfo& info) {
           {"fps", optional_json(info.fps)}};
 }
 
-json scene_camera(const SceneInfo& info) { return info.camera ? pose_row_major(*info.camera) : json(nullptr); }
+json scene_camera(const SceneInfo& info) { return info.camera ? page_pose(*info.camera) : json(nullptr); }
 
 json scene_local_map(const SceneInfo& info) {
   if (!info.local_map) return nullptr;
@@ -213,26 +230,26 @@ json scene_document(const map::MapSnapshot& map, const SceneInfo& info) {
   json ids = json::array(), poses = json::array(), parents = json::array();
   for (const auto& kf : map.keyframes) {
     ids.push_back(kf.id);
-    for (auto& v : pose_row_major(kf.T_wc)) poses.push_back(std::move(v));
+    for (auto& v : page_pose(kf.T_wc)) poses.push_back(std::move(v));
     parents.push_back(kf.parent);
   }
   auto graph = scene_graph(map);
   json point_ids = json::array(), point_xyz = json::array(), line_ids = json::array(), line_xyz = json::array();
   for (const auto& p : map.points) {
     point_ids.push_back(p.id);
-    append(point_xyz, p.position);
+    append_page_position(point_xyz, p.position);
   }
   for (const auto& l : map.lines) {
     line_ids.push_back(l.id);
-    append(line_xyz, l.start);
-    append(line_xyz, l.end);
+    append_page_position(line_xyz, l.start);
+    append_page_position(line_xyz, l.end);
   }
   json trajectory = json::array();
-  for (const auto& c : info.trajectory) append(trajectory, c);
+  for (const auto& c : info.trajectory) append_page_position(trajectory, c);
   json ground_truth = nullptr;
   if (!info.ground_truth.empty()) {
     json positions = json::array();
-    for (const auto& g : info.ground_truth) append(positions, g);
+    for (const auto& g : info.ground_truth) append_page_position(positions, g);
     ground_truth = {{"positions", positions}, {"ate_rmse_m", optional_json(info.ate_rmse_m)}};
   }
   json camera_model = nullptr;
