@@ -11,10 +11,14 @@
 #   browser  --viewer at 5 Hz, the page opened in headless Chromium on this same machine once the
 #            run prints its URL: the browser's launch, page load and software rendering
 #            (SwiftShader) share the two cores with the run
+#   niced    as browser, with Chromium at the lowest CPU priority (nice 19): a viewer on the robot's
+#            own screen that only takes the CPU time SLAM leaves
 #   open     as browser, but Chromium is launched and waiting before the run starts (a page left
 #            open on the robot's own screen): the steady cost of the page's updates and renders
 # Default dataset: the office loop (480 frames, seed 1), rendered into OUT/office when missing.
-# OUT/summary.txt has one line per mode: the runs' medians and the ratio to `off`.
+# OUT/summary.txt has one line per mode: the runs' medians and the ratio of medians to `off`; the
+# median (min-max) of each run's ratio to the `off` run of its own round; and for the browser
+# modes the median CPU seconds Chromium used from opening the page to the run's final state.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=5
@@ -61,6 +65,10 @@ browser() {
   node bench/viewer_follow.mjs "$1"
 }
 
+niced() {
+  nice -n 19 node bench/viewer_follow.mjs "$1"
+}
+
 free_port() {
   python3 -c "import socket; s = socket.socket(); s.bind(('127.0.0.1', 0)); print(s.getsockname()[1])"
 }
@@ -92,25 +100,34 @@ run_one() {  # mode, index
       [ -n "$url" ] && break
       sleep 0.1
     done
-    "$mode" "$url"
+    "$mode" "$url" >"$dir.browser" 2>&1
     kill -TERM "$pid" 2>/dev/null || true
     wait "$pid" || true
   fi
   python3 -c "import json; print(json.load(open('$dir/stats.json'))['tracking_ms']['median'])" >> "$out/$mode.txt"
+  # Chromium's CPU seconds from the page's opening to the run's final state (browser and open)
+  sed -n 's/.*, \([0-9.]*\) s since the page was opened/\1/p' "$dir.browser" 2>/dev/null >> "$out/$mode.cpu" || true
 }
 
-rm -f "$out"/{off,poller,browser,open}.txt
+rm -f "$out"/{off,poller,browser,niced,open}.{txt,cpu}
 for i in $(seq "$runs"); do
-  for mode in off poller browser open; do
+  for mode in off poller browser niced open; do
     run_one "$mode" "$i"
     echo "run $i $mode: $(tail -1 "$out/$mode.txt") ms"
   done
 done
 python3 - "$out" <<'PY' | tee "$out/summary.txt"
-import statistics, sys
+import os, statistics, sys
 out = sys.argv[1]
-med = {m: statistics.median(float(x) for x in open(f"{out}/{m}.txt")) for m in ("off", "poller", "browser", "open")}
-for m in ("off", "poller", "browser", "open"):
-    runs = " ".join(f"{float(x):.1f}" for x in open(f"{out}/{m}.txt"))
-    print(f"{m:8s} median {med[m]:.2f} ms/frame (runs: {runs}), ratio to off {med[m] / med['off']:.3f}")
+modes = ("off", "poller", "browser", "niced", "open")
+runs = {m: [float(x) for x in open(f"{out}/{m}.txt")] for m in modes}
+for m in modes:
+    med = statistics.median(runs[m])
+    # Each run against the `off` run of its own round: drift between rounds cancels.
+    paired = sorted(a / b for a, b in zip(runs[m], runs["off"]))
+    cpu = [float(x) for x in open(f"{out}/{m}.cpu")] if os.path.exists(f"{out}/{m}.cpu") else []
+    cpu = f", Chromium CPU from page open {statistics.median(cpu):.2f} s" if cpu else ""
+    listed = " ".join(f"{x:.1f}" for x in runs[m])
+    print(f"{m:8s} median {med:.2f} ms/frame (runs: {listed}), ratio to off {med / statistics.median(runs['off']):.3f}, "
+          f"per round {statistics.median(paired):.3f} ({paired[0]:.3f}-{paired[-1]:.3f}){cpu}")
 PY

@@ -5,6 +5,8 @@
 //   node bench/viewer_follow.mjs URL --before   launch the browser, print "browser ready", then
 //                                               open the page as soon as a server answers at URL
 //                                               (a page left open while the run starts)
+// At the end it prints Chromium's CPU time: in total, and from the moment the page was opened.
+import fs from 'node:fs';
 import { createRequire } from 'node:module';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -12,6 +14,28 @@ import { fileURLToPath } from 'node:url';
 const web = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../web');
 const { chromium } = createRequire(path.join(web, 'package.json'))('playwright-core');
 const [url, mode] = process.argv.slice(2);
+
+// CPU seconds used so far by this process's descendants: Chromium's browser, renderer and GPU
+// processes, and those of them already reaped by their parent (cutime, cstime).
+function chromiumCpuSeconds() {
+  const parent = new Map(), ticks = new Map();
+  for (const name of fs.readdirSync('/proc')) {
+    if (!/^[0-9]+$/.test(name)) continue;
+    let stat;
+    try { stat = fs.readFileSync(`/proc/${name}/stat`, 'utf8'); } catch { continue; }   // gone
+    const f = stat.slice(stat.lastIndexOf(')') + 2).split(' ');   // f[0] is field 3, the state
+    parent.set(Number(name), Number(f[1]));
+    ticks.set(Number(name), Number(f[11]) + Number(f[12]) + Number(f[13]) + Number(f[14]));
+  }
+  let sum = 0;
+  for (const [pid, t] of ticks) {
+    for (let p = parent.get(pid); p !== undefined && p > 1; p = parent.get(p)) {
+      if (p === process.pid) { sum += t; break; }
+    }
+  }
+  return sum / 100;   // USER_HZ, 100 on Linux
+}
+
 const browser = await chromium.launch({
   executablePath: '/usr/bin/chromium',
   headless: true,
@@ -20,11 +44,13 @@ const browser = await chromium.launch({
 });
 try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  let cpuAtOpen = chromiumCpuSeconds();
   if (mode === '--before') {
     console.log('browser ready');
     const deadline = Date.now() + 60000;
     for (;;) {
       try {
+        cpuAtOpen = chromiumCpuSeconds();
         await page.goto(url);
         break;
       } catch (error) {
@@ -36,6 +62,8 @@ try {
     await page.goto(url);
   }
   await page.waitForFunction(() => window.plslamViewer?.final === true, null, { timeout: 600000, polling: 500 });
+  const cpu = chromiumCpuSeconds();
+  console.log(`chromium cpu ${cpu.toFixed(2)} s, ${(cpu - cpuAtOpen).toFixed(2)} s since the page was opened`);
 } finally {
   await browser.close();
 }
