@@ -24,6 +24,11 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+// `v` rounded to `1 / scale` (scale a power of ten). Dividing the whole number by the exact scale
+// gives the double nearest to the short decimal, which nlohmann::json prints in that many digits;
+// multiplying by 1e-4 instead would often give its neighbour, printed in 17.
+double rounded(double v, double scale) { return std::round(v * scale) / scale; }
+
 // map_graph.json's poses: floats, as the other outputs of a run.
 json pose_row_major(const geometry::SE3& T) {
   json out = json::array();
@@ -92,15 +97,6 @@ void add_ground_truth(const json& stats, SceneInfo& info, const Trajectory& esti
     spdlog::warn("no ground truth shown: {}", e.what());
   }
 }
-
-}  // namespace
-
-namespace {
-
-// `v` rounded to `1 / scale` (scale a power of ten). Dividing the whole number by the exact scale
-// gives the double nearest to the short decimal, which nlohmann::json prints in that many digits;
-// multiplying by 1e-4 instead would often give its neighbour, printed in 17.
-double rounded(double v, double scale) { return std::round(v * scale) / scale; }
 
 }  // namespace
 

@@ -38,9 +38,8 @@ struct SceneInfo {
 nlohmann::json scene_document(const map::MapSnapshot& map, const SceneInfo& info);
 
 // Numbers as the page gets them: positions to a tenth of a millimetre and rotation entries to
-// 1e-6, far below what it can show. Each prints in a few digits, where a float widened to double
-// prints in 17: the documents and deltas are about 2.5 times smaller, and the browser parses them
-// that much faster.
+// 1e-6, far below what it can show. Each prints in 5-8 characters, where a float widened to double
+// prints in up to 20, so documents and deltas are less than half the size on the wire.
 void append_page_position(nlohmann::json& flat, const Eigen::Vector3d& p);
 nlohmann::json page_pose(const geometry::SE3& T_wc);  // row-major 3x4
 
