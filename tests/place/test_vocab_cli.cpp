@@ -91,6 +91,22 @@ TEST(VocabCli, EvalReportsThePrecisionRecallOfADataset) {
   EXPECT_EQ(j["recall_at_precision"], 0.0);
   EXPECT_GT(j["queries"].get<int>(), 0);
   EXPECT_TRUE(j["curve"].is_array());
+  // Every answered query, best score first, each false (no revisit here) and so, by the
+  // definition, more than 2 m or 30 degrees from its top candidate, which is an earlier frame.
+  const auto& answers = j["answers"];
+  ASSERT_TRUE(answers.is_array());
+  EXPECT_EQ(answers.size(), j["curve"].back()["accepted"].get<std::size_t>());
+  for (std::size_t i = 0; i < answers.size(); ++i) {
+    const auto& a = answers[i];
+    EXPECT_FALSE(a["correct"].get<bool>());
+    EXPECT_FALSE(a["has_true_match"].get<bool>());
+    EXPECT_TRUE(a["distance_m"].get<double>() > 2.0 || a["angle_deg"].get<double>() > 30.0) << a.dump();
+    EXPECT_LT(a["top_frame"].get<int>(), a["frame"].get<int>());
+    EXPECT_EQ(a["frame"].get<int>() % 5, 0);
+    if (i > 0) {
+      EXPECT_LE(a["score"].get<double>(), answers[i - 1]["score"].get<double>());
+    }
+  }
   test::TempDir tmp;
   fs::create_directories(tmp.path() / "seq" / "image_0");
   fs::create_directories(tmp.path() / "seq" / "image_1");
