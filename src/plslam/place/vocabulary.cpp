@@ -156,7 +156,7 @@ __attribute__((target("popcnt"))) void descend_popcnt(const std::vector<Vocabula
                                                       std::uint32_t* leaf, std::uint32_t* kept) {
   descend_nodes(nodes, d, node_depth, leaf, kept);
 }
-const bool kHasPopcnt = (__builtin_cpu_init(), __builtin_cpu_supports("popcnt"));
+const bool kDescendWithPopcnt = (__builtin_cpu_init(), __builtin_cpu_supports("popcnt"));
 #endif
 
 }  // namespace
@@ -165,7 +165,7 @@ void Vocabulary::descend(const Descriptor256& d, int levels_up, std::uint32_t* w
   const std::uint32_t node_depth = static_cast<std::uint32_t>(std::max(0, levels_ - levels_up));
   std::uint32_t leaf = 0, kept = 0;
 #if defined(__x86_64__)
-  if (kHasPopcnt) {
+  if (kDescendWithPopcnt) {
     descend_popcnt(nodes_, d, node_depth, &leaf, &kept);
   } else {
     descend_baseline(nodes_, d, node_depth, &leaf, &kept);
