@@ -118,8 +118,8 @@ Vocabulary::Vocabulary(int k, int levels, std::vector<Node> nodes, std::vector<f
 
 namespace {
 
-// The leaf of `d`, and the last node on its path at depth <= node_depth. Inlined into both entry
-// points below, so that each compiles its popcounts for its own target.
+// The leaf of `d`, and the last node on its path at depth <= node_depth. Always inlined, so that
+// descend_popcnt and Vocabulary::descend each compile its popcounts for their own target.
 [[gnu::always_inline]] inline void descend_nodes(const std::vector<Vocabulary::Node>& nodes, const Descriptor256& d,
                                                  std::uint32_t node_depth, std::uint32_t* leaf, std::uint32_t* kept) {
   std::uint32_t at = 0;
@@ -139,11 +139,6 @@ namespace {
     if (nodes[at].depth <= node_depth) *kept = at;
   }
   *leaf = at;
-}
-
-void descend_baseline(const std::vector<Vocabulary::Node>& nodes, const Descriptor256& d, std::uint32_t node_depth,
-                      std::uint32_t* leaf, std::uint32_t* kept) {
-  descend_nodes(nodes, d, node_depth, leaf, kept);
 }
 
 #if defined(__x86_64__)
@@ -168,10 +163,10 @@ void Vocabulary::descend(const Descriptor256& d, int levels_up, std::uint32_t* w
   if (kDescendWithPopcnt) {
     descend_popcnt(nodes_, d, node_depth, &leaf, &kept);
   } else {
-    descend_baseline(nodes_, d, node_depth, &leaf, &kept);
+    descend_nodes(nodes_, d, node_depth, &leaf, &kept);
   }
 #else
-  descend_baseline(nodes_, d, node_depth, &leaf, &kept);
+  descend_nodes(nodes_, d, node_depth, &leaf, &kept);
 #endif
   if (word) *word = static_cast<std::uint32_t>(nodes_[leaf].word);
   if (node) *node = kept;  // the leaf itself when it lies above node_depth
