@@ -72,6 +72,11 @@ TEST(RecognitionEval, EveryRevisitOfASecondLapIsFoundWithFullPrecision) {
     EXPECT_LT(r.curve[k].threshold, r.curve[k - 1].threshold);
     EXPECT_GE(r.curve[k].recall, r.curve[k - 1].recall);
   }
+  // `ranked` holds the answered queries in the order the curve accepts them.
+  ASSERT_EQ(r.ranked.size(), static_cast<std::size_t>(r.curve.back().accepted));
+  for (std::size_t k = 1; k < r.ranked.size(); ++k) {
+    EXPECT_GE(r.queries[r.ranked[k - 1]].score, r.queries[r.ranked[k]].score);
+  }
   // Accepting every top candidate: the first lap's answers are all wrong.
   EXPECT_EQ(r.curve.back().correct, revisits);
   EXPECT_NEAR(r.curve.back().precision, static_cast<double>(revisits) / r.curve.back().accepted, 1e-12);
@@ -90,6 +95,9 @@ TEST(RecognitionEval, AnAliasedPlaceCostsPrecisionAtFullRecall) {
   EXPECT_FALSE(q12.has_true_match);
   EXPECT_EQ(q12.top, 5);
   EXPECT_FALSE(q12.correct);
+  // 7 of 20 places around the 20 m circle: 126 degrees turned, the chord 2 R sin(63 deg) away.
+  EXPECT_NEAR(q12.top_angle_deg, 126.0, 1e-9);
+  EXPECT_NEAR(q12.top_distance_m, 2 * (20 / (2 * std::numbers::pi)) * std::sin(63.0 * std::numbers::pi / 180), 1e-9);
   // Its score ranks with the true revisits: no threshold keeps every revisit without it.
   EXPECT_LT(r.curve.back().precision, 1.0);
   EXPECT_LT(r.recall_at_precision(1.0), 1.0);

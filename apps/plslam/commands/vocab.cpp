@@ -9,8 +9,6 @@
 #include <iostream>
 #include <filesystem>
 #include <memory>
-#include <numbers>
-#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -193,20 +191,6 @@ int run_vocab_eval(const VocabEvalArgs& args) {
   }
   const auto r = place::evaluate_place_recognition(samples, vocabulary);
   const double recall = r.recall_at_precision(args.precision);
-  // Every answered query, best score first (the order the curve accepts them in), with how far
-  // its top candidate is: what a false one is (a near miss, a look-alike, a view from the other
-  // end) decides what could remove it.
-  std::vector<const place::RecognitionQuery*> answered;
-  for (const auto& q : r.queries) {
-    if (q.top >= 0) answered.push_back(&q);
-  }
-  std::stable_sort(answered.begin(), answered.end(), [](const auto* a, const auto* b) { return a->score > b->score; });
-  auto apart = [&](const place::RecognitionQuery& q) {
-    const auto& a = samples[q.sample];
-    const auto& b = samples[static_cast<std::size_t>(q.top)];
-    const double angle = std::acos(std::clamp(a.direction.dot(b.direction), -1.0, 1.0)) * 180.0 / std::numbers::pi;
-    return std::make_pair((a.centre - b.centre).norm(), angle);
-  };
   double threshold = 0;
   for (const auto& p : r.curve) {
     if (p.precision >= args.precision && p.recall == recall) threshold = p.threshold;
@@ -217,12 +201,15 @@ int run_vocab_eval(const VocabEvalArgs& args) {
       curve.push_back({{"threshold", p.threshold}, {"accepted", p.accepted}, {"correct", p.correct},
                        {"precision", p.precision}, {"recall", p.recall}});
     }
+    // Every answered query in the curve's order, with how far its top candidate is: what a false
+    // one is (a near miss, a look-alike, a view from the other end) decides what could remove it.
     nlohmann::json answers = nlohmann::json::array();
-    for (const auto* q : answered) {
-      const auto [distance, angle] = apart(*q);
-      answers.push_back({{"frame", frame_of[q->sample]}, {"top_frame", frame_of[static_cast<std::size_t>(q->top)]},
-                         {"score", q->score}, {"raw_score", q->raw_score}, {"correct", q->correct},
-                         {"has_true_match", q->has_true_match}, {"distance_m", distance}, {"angle_deg", angle}});
+    for (const std::size_t k : r.ranked) {
+      const auto& q = r.queries[k];
+      answers.push_back({{"frame", frame_of[q.sample]}, {"top_frame", frame_of[static_cast<std::size_t>(q.top)]},
+                         {"score", q.score}, {"raw_score", q.raw_score}, {"correct", q.correct},
+                         {"has_true_match", q.has_true_match}, {"distance_m", q.top_distance_m},
+                         {"angle_deg", q.top_angle_deg}});
     }
     nlohmann::json j = {{"dataset", ds->root().string()}, {"vocabulary", voc_path.string()},
                         {"keyframes", samples.size()},     {"every", args.every},
@@ -240,14 +227,14 @@ int run_vocab_eval(const VocabEvalArgs& args) {
       "precision {:.3f}, recall {:.3f}\n",
       ds->root().string(), samples.size(), args.every, r.queries.size(), r.with_true_match, recall, args.precision,
       threshold, top1, r.curve.empty() ? 0.0 : r.curve.back().recall);
-  const auto first_false = std::find_if(answered.begin(), answered.end(), [](const auto* q) { return !q->correct; });
-  if (first_false != answered.end()) {
-    const auto& q = **first_false;
-    const auto [distance, angle] = apart(q);
+  const auto first_false =
+      std::find_if(r.ranked.begin(), r.ranked.end(), [&](std::size_t k) { return !r.queries[k].correct; });
+  if (first_false != r.ranked.end()) {
+    const auto& q = r.queries[*first_false];
     std::cout << fmt::format("best-scoring false candidate (rank {}): frame {} -> frame {}, score {:.4f}, {:.2f} m and "
                              "{:.0f} deg apart{}\n",
-                             first_false - answered.begin() + 1, frame_of[q.sample],
-                             frame_of[static_cast<std::size_t>(q.top)], q.score, distance, angle,
+                             first_false - r.ranked.begin() + 1, frame_of[q.sample],
+                             frame_of[static_cast<std::size_t>(q.top)], q.score, q.top_distance_m, q.top_angle_deg,
                              q.has_true_match ? "" : " (the query has no true match)");
   }
   return 0;

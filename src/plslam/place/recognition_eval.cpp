@@ -59,24 +59,28 @@ RecognitionEvalResult evaluate_place_recognition(const std::vector<PlaceSample>&
       // before it, the best score it can expect from the same place.
       const double reference = l1_score(bow, db.describe(samples[i - 1].descriptors).bow);
       q.score = reference > 0 ? q.raw_score / reference : 0;
+      const auto& top = samples[static_cast<std::size_t>(q.top)];
       q.correct = true_match(i, static_cast<std::size_t>(q.top));
+      q.top_distance_m = (samples[i].centre - top.centre).norm();
+      const double cos_angle = std::clamp(samples[i].direction.dot(top.direction), -1.0, 1.0);
+      q.top_angle_deg = std::acos(cos_angle) * 180.0 / std::numbers::pi;
     }
     r.with_true_match += q.has_true_match;
     r.queries.push_back(q);
   }
   // Thresholds at every distinct top score, highest first.
-  std::vector<const RecognitionQuery*> answered;
-  for (const auto& q : r.queries) {
-    if (q.top >= 0) answered.push_back(&q);
+  for (std::size_t k = 0; k < r.queries.size(); ++k) {
+    if (r.queries[k].top >= 0) r.ranked.push_back(k);
   }
-  std::stable_sort(answered.begin(), answered.end(),
-                   [](const RecognitionQuery* a, const RecognitionQuery* b) { return a->score > b->score; });
+  std::stable_sort(r.ranked.begin(), r.ranked.end(),
+                   [&](std::size_t a, std::size_t b) { return r.queries[a].score > r.queries[b].score; });
+  const auto answered = [&](std::size_t k) -> const RecognitionQuery& { return r.queries[r.ranked[k]]; };
   PrPoint p;
-  for (std::size_t k = 0; k < answered.size(); ++k) {
+  for (std::size_t k = 0; k < r.ranked.size(); ++k) {
     ++p.accepted;
-    p.correct += answered[k]->correct;
-    if (k + 1 < answered.size() && answered[k + 1]->score == answered[k]->score) continue;
-    p.threshold = answered[k]->score;
+    p.correct += answered(k).correct;
+    if (k + 1 < r.ranked.size() && answered(k + 1).score == answered(k).score) continue;
+    p.threshold = answered(k).score;
     p.precision = static_cast<double>(p.correct) / p.accepted;
     p.recall = r.with_true_match > 0 ? static_cast<double>(p.correct) / r.with_true_match : 0;
     r.curve.push_back(p);

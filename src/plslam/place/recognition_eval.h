@@ -38,6 +38,7 @@ struct RecognitionQuery {
   double raw_score = 0;  // its L1 score
   double score = 0;      // normalised: raw_score / the L1 score of the query with the sample before it
   bool correct = false;  // the top candidate is a true match
+  double top_distance_m = 0, top_angle_deg = 0;  // between the query's camera and the top candidate's
 };
 
 struct PrPoint {
@@ -48,6 +49,7 @@ struct PrPoint {
 
 struct RecognitionEvalResult {
   std::vector<RecognitionQuery> queries;  // samples that had a database to query
+  std::vector<std::size_t> ranked;        // indices into queries of the answered ones, best score first
   int with_true_match = 0;
   std::vector<PrPoint> curve;             // one point per distinct score, thresholds descending
   // The highest recall at a threshold whose precision is at least `precision` (0 if none).
