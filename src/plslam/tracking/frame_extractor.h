@@ -34,8 +34,8 @@ struct FrameExtractorOptions {
 };
 
 struct FrameTimings {
-  double extraction_ms = 0;  // wall clock of the four extraction tasks (and the guided line search)
-  double stereo_ms = 0;      // wall clock of the matching tasks after them
+  double extraction_ms = 0;  // wall clock of the lanes, with the stereo point and guided line matching
+  double stereo_ms = 0;      // wall clock of the matching after them (detected right lines only)
   double total_ms = 0;       // extraction + stereo + assembly
   features::ExtractionTimings left_points;
   features::LineTimings left_lines;
