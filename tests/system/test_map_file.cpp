@@ -141,7 +141,7 @@ TEST_F(MapReuse, RestoredObjectsAreTheSavedOnes) {
     EXPECT_EQ(points[i]->id(), saved.id);
     EXPECT_EQ(points[i]->position(), saved.a);
     EXPECT_EQ(static_cast<std::size_t>(points[i]->num_observations()), saved.observations.size());
-    for (const auto& [kf, idx] : points[i]->observations()) EXPECT_EQ(kf->map_point(idx), points[i]);
+    for (const auto& [kf, idx] : points[i]->observation_list()) EXPECT_EQ(kf->map_point(idx), points[i]);
   }
   // New objects never reuse a saved id.
   auto* p = map.create_point(Eigen::Vector3d::Zero(), kfs.front(), 0);

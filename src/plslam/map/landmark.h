@@ -10,9 +10,6 @@
 // while local mapping writes it. Member definitions: landmark_impl.h, instantiated by the derived
 // classes' .cpp files.
 #include <atomic>
-#include <map>
-
-#include "plslam/map/by_id.h"
 #include <mutex>
 #include <utility>
 #include <vector>
@@ -42,18 +39,20 @@ class Landmark {
   long id() const { return id_; }
   long created_frame() const { return created_frame_; }
 
-  // Observations: keyframe -> index of the feature in that keyframe. A bad landmark takes none
-  // (returns false): the caller must not leave it in the keyframe's slot, where it would outlive
-  // reclamation (Map::reclaim).
+  // Observations: keyframe -> index of the feature in that keyframe, in keyframe-id order (never
+  // address order, see by_id.h). A flat sorted vector rather than a std::map: a landmark has a
+  // handful of observations, and the local BA window, the landmark updates and keyframe culling
+  // copy or walk those of thousands of landmarks per keyframe (the tree walk alone was 5 % of a
+  // street run's CPU).
+  using ObservationList = std::vector<std::pair<KeyFrame*, int>>;
+  // A bad landmark takes none (returns false): the caller must not leave it in the keyframe's
+  // slot, where it would outlive reclamation (Map::reclaim).
   bool add_observation(KeyFrame* kf, int index);
   // Removes one; a landmark left with fewer than two observing keyframes turns bad.
   void erase_observation(KeyFrame* kf);
-  IdMap<KeyFrame, int> observations() const;
-  // The same, in keyframe-id order, in one allocation rather than one tree node each: the local
-  // BA window and the landmark updates read thousands of landmarks per keyframe.
-  std::vector<std::pair<KeyFrame*, int>> observation_list() const;
+  ObservationList observation_list() const;
   // Calls f(keyframe, index) for each observation under the landmark's lock, without the copy
-  // observations() makes (the per-frame covisibility counts visit thousands of landmarks). f must
+  // observation_list() makes (the per-frame covisibility counts visit thousands of landmarks). f must
   // take no lock and must not call back into this landmark.
   template <typename F>
   void for_each_observation(F&& f) const {
@@ -105,7 +104,7 @@ class Landmark {
   const long created_frame_;
   Eigen::Vector3d normal_ = Eigen::Vector3d::Zero();
   cv::Mat descriptor_;
-  IdMap<KeyFrame, int> observations_;
+  ObservationList observations_;  // sorted by keyframe id
   int observation_weight_ = 0;
   KeyFrame* reference_;
   double min_distance_ = 0, max_distance_ = 0;

@@ -1,5 +1,6 @@
 #pragma once
 // Definitions of Landmark<Derived>; included by map_point.cpp and map_line.cpp only.
+#include <algorithm>
 #include <vector>
 
 #include "plslam/map/descriptor_utils.h"
@@ -8,15 +9,26 @@
 
 namespace plslam::map {
 
+namespace landmark_detail {
+// The first observation whose keyframe id is not below kf's: kf's own if it is there.
+template <class List>
+auto lower_bound_by_id(List& list, const KeyFrame* kf) {
+  return std::lower_bound(list.begin(), list.end(), kf->id(),
+                          [](const auto& o, long id) { return o.first->id() < id; });
+}
+}  // namespace landmark_detail
+
 template <class D>
 bool Landmark<D>::add_observation(KeyFrame* kf, int index) {
   const int weight = D::is_stereo(*kf, index) ? 2 : 1;
   std::lock_guard lock(mutex_);
   if (bad_) return false;
-  const auto [it, inserted] = observations_.try_emplace(kf, index);
-  if (!inserted) {
+  const auto it = landmark_detail::lower_bound_by_id(observations_, kf);
+  if (it != observations_.end() && it->first->id() == kf->id()) {
     observation_weight_ -= D::is_stereo(*kf, it->second) ? 2 : 1;
     it->second = index;
+  } else {
+    observations_.emplace(it, kf, index);
   }
   observation_weight_ += weight;
   return true;
@@ -27,8 +39,8 @@ void Landmark<D>::erase_observation(KeyFrame* kf) {
   bool now_bad = false;
   {
     std::lock_guard lock(mutex_);
-    const auto it = observations_.find(kf);
-    if (it == observations_.end()) return;
+    const auto it = landmark_detail::lower_bound_by_id(observations_, kf);
+    if (it == observations_.end() || it->first->id() != kf->id()) return;
     observation_weight_ -= D::is_stereo(*kf, it->second) ? 2 : 1;
     observations_.erase(it);
     if (reference_ == kf && !observations_.empty()) reference_ = observations_.begin()->first;
@@ -39,15 +51,9 @@ void Landmark<D>::erase_observation(KeyFrame* kf) {
 }
 
 template <class D>
-IdMap<KeyFrame, int> Landmark<D>::observations() const {
+typename Landmark<D>::ObservationList Landmark<D>::observation_list() const {
   std::lock_guard lock(mutex_);
   return observations_;
-}
-
-template <class D>
-std::vector<std::pair<KeyFrame*, int>> Landmark<D>::observation_list() const {
-  std::lock_guard lock(mutex_);
-  return {observations_.begin(), observations_.end()};
 }
 
 template <class D>
@@ -65,8 +71,8 @@ int Landmark<D>::observation_weight() const {
 template <class D>
 int Landmark<D>::index_in(const KeyFrame* kf) const {
   std::lock_guard lock(mutex_);
-  const auto it = observations_.find(const_cast<KeyFrame*>(kf));
-  return it == observations_.end() ? -1 : it->second;
+  const auto it = landmark_detail::lower_bound_by_id(observations_, kf);
+  return it == observations_.end() || it->first->id() != kf->id() ? -1 : it->second;
 }
 
 template <class D>
@@ -141,7 +147,7 @@ double Landmark<D>::found_ratio() const {
 
 template <class D>
 void Landmark<D>::set_bad() {
-  IdMap<KeyFrame, int> obs;
+  ObservationList obs;
   {
     std::lock_guard lock(mutex_);
     if (bad_.load(std::memory_order_relaxed)) return;
@@ -159,7 +165,7 @@ template <class D>
 void Landmark<D>::replace_with(D* other) {
   D* self = static_cast<D*>(this);
   if (other == self || !other) return;
-  IdMap<KeyFrame, int> obs;
+  ObservationList obs;
   int visible = 0, found = 0;
   {
     std::lock_guard lock(mutex_);

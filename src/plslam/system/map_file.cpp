@@ -533,7 +533,7 @@ MapContents capture_map(const map::Map& map, const place::KeyframeDatabase* data
     using Landmark = std::remove_cv_t<std::remove_pointer_t<decltype(landmark)>>;
     l.id = landmark->id();
     l.created_frame = landmark->created_frame();
-    for (const auto& [kf, index] : landmark->observations()) {
+    for (const auto& [kf, index] : landmark->observation_list()) {
       if (!known(kf)) continue;
       // The keyframe's slot decides: an observation whose slot holds another landmark (or none)
       // is not what tracking and matching see, and would make the file inconsistent.
