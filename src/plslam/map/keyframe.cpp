@@ -211,11 +211,6 @@ void KeyFrame::change_parent(KeyFrame* kf) {
   kf->add_child(this);
 }
 
-bool KeyFrame::is_bad() const {
-  std::lock_guard lock(graph_mutex_);
-  return bad_;
-}
-
 geometry::SE3 KeyFrame::pose_relative_to_parent() const {
   std::lock_guard lock(graph_mutex_);
   return T_cp_;
@@ -298,7 +293,7 @@ void KeyFrame::set_bad() {
   if (parent) parent->erase_child(this);
   std::lock_guard lock(graph_mutex_);
   if (parent) T_cp_ = pose() * parent->pose_inverse();
-  bad_ = true;
+  bad_.store(true, std::memory_order_release);
 }
 
 }  // namespace plslam::map

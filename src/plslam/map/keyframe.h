@@ -4,6 +4,7 @@
 // Owned by the Map; other objects hold non-owning pointers. Pose, associations and graph edges
 // each have their own mutex because tracking, local mapping and (later) loop closing use them
 // concurrently.
+#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -87,7 +88,9 @@ class KeyFrame {
   // re-parents its children to their best covisible candidate, and remembers its pose relative
   // to its parent so that frames that referenced it keep a valid pose.
   void set_bad();
-  bool is_bad() const;
+  // Inline and lock-free, as Landmark::is_bad: local mapping asks it of every observing keyframe
+  // of every landmark it touches.
+  bool is_bad() const { return bad_.load(std::memory_order_acquire); }
   // For a bad keyframe: T_cp, its pose relative to its parent at the time it was culled.
   geometry::SE3 pose_relative_to_parent() const;
 
@@ -111,7 +114,8 @@ class KeyFrame {
   IdSet<KeyFrame> children_;
   IdSet<KeyFrame> loop_edges_;
   bool first_connection_ = true;
-  bool bad_ = false;
+  // Set under graph_mutex_, after T_cp_ (release); read without it by is_bad().
+  std::atomic<bool> bad_{false};
   geometry::SE3 T_cp_;
 
   void sort_connections_locked();

@@ -312,10 +312,10 @@ Groups<Kind> make_groups(const BaProblem& p, const BaOptions& opt, const std::ve
   for (std::size_t k = 0; k < obs.size(); ++k) {
     if (out && (*out)[k]) continue;
     const int l = Kind::landmark(obs[k]);
-    const ObsRef ref{static_cast<int>(k), obs[k].keyframe,
-                     cam_of_kf[static_cast<std::size_t>(obs[k].keyframe)], Kind::info(obs[k], opt)};
     if (Kind::fixed(p, l)) {
-      G.fixed.push_back(ref);
+      // The information (a pow per observation) only where the reference is kept.
+      G.fixed.push_back({static_cast<int>(k), obs[k].keyframe,
+                         cam_of_kf[static_cast<std::size_t>(obs[k].keyframe)], Kind::info(obs[k], opt)});
       continue;
     }
     int& slot = slot_of[static_cast<std::size_t>(l)];
