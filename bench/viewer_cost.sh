@@ -2,7 +2,7 @@
 # What the live viewer costs tracking (issue 17): the same sequence run N times each way,
 # alternating, in the default concurrent mode, and the median of each run's median tracking ms.
 #
-#   bench/viewer_cost.sh [--runs N] [--dataset DIR] OUT
+#   bench/viewer_cost.sh [--runs N] [--dataset DIR] [--modes "off browser ..."] OUT
 #
 #   off      plslam run without --viewer
 #   poller   --viewer at 5 Hz with a client that follows it as the page does (deltas every 200 ms,
@@ -11,8 +11,11 @@
 #   browser  --viewer at 5 Hz, the page opened in headless Chromium on this same machine once the
 #            run prints its URL: the browser's launch, page load and software rendering
 #            (SwiftShader) share the two cores with the run
-#   niced    as browser, with Chromium at the lowest CPU priority (nice 19): a viewer on the robot's
-#            own screen that only takes the CPU time SLAM leaves
+#   niced    as browser, with Chromium at the lowest nice level (19). On these machines' kernel
+#            (EEVDF) nice 19 still takes a large share: two nice-19 busy loops slow a nice-0 one by
+#            28 %
+#   idle     as browser, with Chromium in the SCHED_IDLE class (`chrt --idle 0`): it runs only on a
+#            core that SLAM leaves free, and a woken SLAM thread preempts it at once
 #   open     as browser, but Chromium is launched and waiting before the run starts (a page left
 #            open on the robot's own screen): the steady cost of the page's updates and renders
 # Default dataset: the office loop (480 frames, seed 1), rendered into OUT/office when missing.
@@ -23,14 +26,20 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=5
 dataset=""
+modes="off poller browser niced idle open"
 while [ $# -gt 1 ]; do
   case "$1" in
     --runs) runs=$2; shift 2 ;;
     --dataset) dataset=$2; shift 2 ;;
+    --modes) modes=$2; shift 2 ;;
     *) echo "viewer_cost.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
-out=${1:?usage: bench/viewer_cost.sh [--runs N] [--dataset DIR] OUT}
+out=${1:?usage: bench/viewer_cost.sh [--runs N] [--dataset DIR] [--modes LIST] OUT}
+case " $modes " in *" off "*) ;; *) echo "viewer_cost.sh: --modes must include off (the baseline)" >&2; exit 2 ;; esac
+for m in $modes; do
+  case "$m" in off|poller|browser|niced|idle|open) ;; *) echo "viewer_cost.sh: unknown mode $m" >&2; exit 2 ;; esac
+done
 plslam=${PLSLAM:-build/plslam}
 [ -x "$plslam" ] || { echo "viewer_cost.sh: $plslam not built" >&2; exit 2; }
 mkdir -p "$out"
@@ -69,6 +78,10 @@ niced() {
   nice -n 19 node bench/viewer_follow.mjs "$1"
 }
 
+idle() {
+  chrt --idle 0 node bench/viewer_follow.mjs "$1"
+}
+
 free_port() {
   python3 -c "import socket; s = socket.socket(); s.bind(('127.0.0.1', 0)); print(s.getsockname()[1])"
 }
@@ -105,21 +118,21 @@ run_one() {  # mode, index
     wait "$pid" || true
   fi
   python3 -c "import json; print(json.load(open('$dir/stats.json'))['tracking_ms']['median'])" >> "$out/$mode.txt"
-  # Chromium's CPU seconds from the page's opening to the run's final state (browser and open)
+  # Chromium's CPU seconds from the page's opening to the run's final state (the browser modes)
   sed -n 's/.*, \([0-9.]*\) s since the page was opened/\1/p' "$dir.browser" 2>/dev/null >> "$out/$mode.cpu" || true
 }
 
-rm -f "$out"/{off,poller,browser,niced,open}.{txt,cpu}
+rm -f "$out"/{off,poller,browser,niced,idle,open}.{txt,cpu}
 for i in $(seq "$runs"); do
-  for mode in off poller browser niced open; do
+  for mode in $modes; do
     run_one "$mode" "$i"
     echo "run $i $mode: $(tail -1 "$out/$mode.txt") ms"
   done
 done
-python3 - "$out" <<'PY' | tee "$out/summary.txt"
+python3 - "$out" $modes <<'PY' | tee "$out/summary.txt"
 import os, statistics, sys
 out = sys.argv[1]
-modes = ("off", "poller", "browser", "niced", "open")
+modes = sys.argv[2:]
 runs = {m: [float(x) for x in open(f"{out}/{m}.txt")] for m in modes}
 for m in modes:
     med = statistics.median(runs[m])
