@@ -38,8 +38,8 @@ std::string stage_line(const nlohmann::json& j, const char* key, const char* lab
                      s.at("p90").get<double>());
 }
 
-// The whole stereo frame as the tracker gets it: four extraction tasks (left/right x
-// points/lines) then two stereo matching tasks, wall clock with the machine's threads.
+// The whole stereo frame as the tracker gets it (tracking::FrameExtractor: a lines lane and a
+// points lane, with their stereo matching), wall clock with the machine's threads.
 nlohmann::json frame_benchmark(const io::Dataset& ds, bool kitti) {
   tracking::FrameExtractor extractor(ds.calibration(), kitti ? tracking::FrameExtractorOptions::kitti()
                                                              : tracking::FrameExtractorOptions::euroc());

@@ -1,8 +1,9 @@
 #pragma once
-// The paper's frame integration: four concurrent extraction tasks (left/right x points/lines),
-// then two concurrent stereo matching tasks (points, lines), assembled into one FrameData. With
-// guided stereo lines there is no right-line task: the left-line task goes on to search the right
-// image along each line's rows, so the line matching happens in the extraction phase.
+// The paper's frame integration: points and lines of both images are extracted and matched in
+// stereo concurrently, and assembled into one FrameData. It runs as two lanes, one per core of
+// the 2-core target: the left lines, then the guided search for them along their rows in the
+// right image; and the left points, the right points, then their stereo matching. Without guided
+// lines, the right lines are a third task, matched after the join.
 #include <memory>
 
 #include <opencv2/core.hpp>
