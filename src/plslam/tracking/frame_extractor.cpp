@@ -4,7 +4,6 @@
 
 #include <chrono>
 
-#include <future>
 #include <vector>
 
 #include "plslam/geometry/stereo_camera.h"
@@ -30,7 +29,8 @@ FrameExtractor::FrameExtractor(const StereoCalibration& calib, FrameExtractorOpt
     : calib_(calib),
       options_(std::move(options)),
       left_orb_(options_.orb),
-      right_orb_(matching::right_image_options(options_.orb, options_.right_points_factor)) {
+      right_orb_(matching::right_image_options(options_.orb, options_.right_points_factor)),
+      lanes_(std::make_unique<core::WorkerPool>(2)) {
   options_.line_extractor.min_angle_from_horizontal_deg = options_.stereo_lines.min_angle_from_horizontal_deg;
   options_.stereo_points.bf = calib_.bf();
   options_.stereo_points.baseline = calib_.baseline;
@@ -52,38 +52,59 @@ std::shared_ptr<map::FrameData> FrameExtractor::extract(long frame_id, double ti
   std::vector<matching::StereoLineMatch> sl;
   double sp_ms = 0, sl_ms = 0;
   {
-    // Two lanes, not one thread per task: with the three tasks of the guided default on 2 cores,
-    // the kernel shares them out evenly, so the longest lane (left lines, then the guided search)
-    // ran at two-thirds speed until the point tasks ended: 11.8 ms on the street loop against the
-    // 9.2 ms of that lane alone. Here the lines run on their own thread while this one extracts
-    // the left points, then the right points, and matches them in stereo (8.8 ms together).
-    // Plain threads rather than a TBB task group: the join is a synchronisation ThreadSanitizer
-    // can see (libtbb is not instrumented), and a few coarse tasks do not need a scheduler.
-    std::vector<std::future<void>> tasks;
-    if (options_.lines) {
-      tasks.push_back(std::async(std::launch::async, [&] {
-        ll = features::extract_lines(left, options_.line_extractor, &tll);
-        // The guided search needs no right features, so it follows the left lines at once.
-        if (options_.guided_stereo_lines) {
-          const auto s = std::chrono::steady_clock::now();
-          sl = matching::match_stereo_lines_guided(ll, left, right, calib_, options_.stereo_lines, options_.guided_lines);
-          sl_ms = ms_since(s);
-        }
-      }));
-      if (!options_.guided_stereo_lines)
-        tasks.push_back(std::async(std::launch::async, [&] { lr = features::extract_lines(right, options_.line_extractor); }));
+    // Two lanes on a persistent pool of two threads (this one and a worker):
+    // - not one thread per task: with the three tasks of the guided default on 2 cores, the
+    //   kernel shared them out evenly, so the longest lane (left lines, then the guided search)
+    //   ran at two-thirds speed until the point tasks ended (11.8 ms on the street loop, where
+    //   that lane alone takes 9.2 ms and the points lane 8.8 ms);
+    // - not a thread started per frame: after the idle time between frames at the camera's
+    //   rate, the kernel put a new thread on its starter's core in 44 of 51 frames, and the
+    //   lanes took turns there (KITTI 06 with 80 ms sleeps: 15.4-18.9 ms per frame against
+    //   12.4-14.8 ms with the pool's waiting worker, which starts there less often).
+    // This thread takes chunk 0, the lines, at once; if the worker is slow to wake, this thread
+    // also runs the points when done. WorkerPool rather than TBB: its hand-over is a mutex and a
+    // condition variable, which ThreadSanitizer sees (libtbb is not instrumented).
+    const auto points_lane = [&] {
       pl = left_orb_.extract(left, &tl);
       pr = right_orb_.extract(right);
+      const auto s = std::chrono::steady_clock::now();
+      sp = matching::match_stereo_points(pl, pr, options_.stereo_points);
+      sp_ms = ms_since(s);
+    };
+    const auto lines_lane = [&] {
+      ll = features::extract_lines(left, options_.line_extractor, &tll);
+      // The guided search needs no right features, so it follows the left lines at once.
+      if (options_.guided_stereo_lines) {
+        const auto s = std::chrono::steady_clock::now();
+        sl = matching::match_stereo_lines_guided(ll, left, right, calib_, options_.stereo_lines, options_.guided_lines);
+        sl_ms = ms_since(s);
+      }
+    };
+    std::lock_guard lock(lanes_mutex_);  // the pool runs one frame at a time
+    if (options_.lines) {
+      // Without guided lines, the right lines are a third chunk for whichever thread is free.
+      lanes_->run(options_.guided_stereo_lines ? 2 : 3, [&](int c) {
+        if (c == 0) {
+          lines_lane();
+        } else if (c == 1) {
+          points_lane();
+        } else {
+          lr = features::extract_lines(right, options_.line_extractor);
+        }
+      });
     } else {
-      // Without lines the two point tasks are the lanes.
-      auto right_task = std::async(std::launch::async, [&] { pr = right_orb_.extract(right); });
-      pl = left_orb_.extract(left, &tl);
-      right_task.get();
+      // Without lines the two images' points are the lanes.
+      lanes_->run(2, [&](int c) {
+        if (c == 0) {
+          pl = left_orb_.extract(left, &tl);
+        } else {
+          pr = right_orb_.extract(right);
+        }
+      });
+      const auto s = std::chrono::steady_clock::now();
+      sp = matching::match_stereo_points(pl, pr, options_.stereo_points);
+      sp_ms = ms_since(s);
     }
-    const auto s = std::chrono::steady_clock::now();
-    sp = matching::match_stereo_points(pl, pr, options_.stereo_points);
-    sp_ms = ms_since(s);
-    for (auto& t : tasks) t.get();
   }
   const auto t1 = std::chrono::steady_clock::now();
   // Detected right lines are matched once both line tasks are done.

@@ -5,10 +5,12 @@
 // right image; and the left points, the right points, then their stereo matching. Without guided
 // lines, the right lines are a third task, matched after the join.
 #include <memory>
+#include <mutex>
 
 #include <opencv2/core.hpp>
 
 #include "plslam/core/types.h"
+#include "plslam/core/worker_pool.h"
 #include "plslam/features/line_extractor.h"
 #include "plslam/features/orb_extractor.h"
 #include "plslam/map/frame_data.h"
@@ -48,6 +50,7 @@ class FrameExtractor {
  public:
   FrameExtractor(const StereoCalibration& calib, FrameExtractorOptions options);
 
+  // Safe to call from several threads; the calls take turns.
   std::shared_ptr<map::FrameData> extract(long frame_id, double timestamp, const cv::Mat& left,
                                           const cv::Mat& right, FrameTimings* timings = nullptr) const;
 
@@ -59,6 +62,8 @@ class FrameExtractor {
   FrameExtractorOptions options_;
   features::OrbExtractor left_orb_;
   features::OrbExtractor right_orb_;
+  std::unique_ptr<core::WorkerPool> lanes_;  // this thread and one waiting worker
+  mutable std::mutex lanes_mutex_;
 };
 
 }  // namespace plslam::tracking
