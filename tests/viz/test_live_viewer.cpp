@@ -122,6 +122,30 @@ TEST(SceneDelta, SmallMovesAddUpUntilTheyAreSentAndNumbersAreShort) {
   EXPECT_EQ(scene_delta(after, later, info, 0, 2)["points"]["ids"], json({2}));
 }
 
+// The local map's ids go out when they differ from those the page got last, and are left out
+// while they are the same (the page keeps its own); without the page's info they always go out.
+TEST(SceneDelta, TheLocalMapIsSentOnlyWhenItChanged) {
+  const auto map = two_keyframes();
+  SceneInfo page_info;
+  page_info.local_map = std::make_pair(std::vector<long>{0, 1}, std::vector<long>{1, 2});
+  SceneInfo info = page_info;
+  const json same = scene_delta(map, map, info, 0, 2, kPageMinMove, nullptr, &page_info);
+  EXPECT_FALSE(same.contains("local_map"));
+  EXPECT_TRUE(same.contains("counts"));  // the rest of the delta is there
+  EXPECT_EQ(scene_delta(map, map, info, 0, 2)["local_map"]["points"], json({1, 2}));
+
+  info.local_map->second.push_back(3);
+  const json grown = scene_delta(map, map, info, 0, 3, kPageMinMove, nullptr, &page_info);
+  EXPECT_EQ(grown["local_map"]["keyframes"], json({0, 1}));
+  EXPECT_EQ(grown["local_map"]["points"], json({1, 2, 3}));
+
+  // A lost camera has no local map: the page is told (null), not left with the old one.
+  info.local_map.reset();
+  const json lost = scene_delta(map, map, info, 0, 4, kPageMinMove, nullptr, &page_info);
+  ASSERT_TRUE(lost.contains("local_map"));
+  EXPECT_TRUE(lost["local_map"].is_null());
+}
+
 // Centres move with their keyframes; the page gets the new tail, or the whole trail once a centre
 // it has moved by more than the threshold (a loop correction), and never for local BA's millimetres.
 TEST(LiveTrail, CentresFollowTheirKeyframesAndAreResentOnlyWhenTheyMovedFar) {

@@ -52,8 +52,8 @@ class Landmark {
   void erase_observation(KeyFrame* kf);
   ObservationList observation_list() const;
   // Calls f(keyframe, index) for each observation under the landmark's lock, without the copy
-  // observation_list() makes (the per-frame covisibility counts visit thousands of landmarks). f must
-  // take no lock and must not call back into this landmark.
+  // observation_list() makes (the per-frame covisibility counts visit thousands of landmarks).
+  // f must take no lock and must not call back into this landmark.
   template <typename F>
   void for_each_observation(F&& f) const {
     std::lock_guard lock(mutex_);

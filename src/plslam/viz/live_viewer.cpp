@@ -81,7 +81,7 @@ void LiveTrail::sent(bool whole) {
 
 json scene_delta(const map::MapSnapshot& page, const map::MapSnapshot& after, const SceneInfo& info,
                  std::optional<std::size_t> trail_sent, long revision, double min_move_m,
-                 map::MapSnapshot* page_after) {
+                 map::MapSnapshot* page_after, const SceneInfo* page_info) {
   // What the page will hold: `after`, with the unsent keyframes and landmarks where the page has
   // them. Filled in below when asked for.
   if (page_after) *page_after = after;
@@ -169,6 +169,7 @@ json scene_delta(const map::MapSnapshot& page, const map::MapSnapshot& after, co
     d["loop_edges"] = std::move(graph.loop_edges);
     d["covisibility"] = std::move(graph.covisibility);
   }
+  if (page_info && info.local_map == page_info->local_map) d.erase("local_map");
   return d;
 }
 
@@ -248,13 +249,10 @@ void LiveViewer::publish_once() {
   const long revision = revision_.load() + 1;
   info.revision = revision;
   map::MapSnapshot page_after;
-  auto delta_json = scene_delta(page_, scene->map, info,
-                                resend_trail ? std::nullopt : std::optional(trail_.page_size()), revision,
-                                kPageMinMove, &page_after);
-  // The local map's ids (thousands) change with keyframes, not with every update: the page keeps
-  // the last ones it got.
-  if (info.local_map == last_->info.local_map) delta_json.erase("local_map");
-  const auto delta = delta_json.dump();
+  const auto delta = scene_delta(page_, scene->map, info,
+                                 resend_trail ? std::nullopt : std::optional(trail_.page_size()), revision,
+                                 kPageMinMove, &page_after, &last_->info)
+                         .dump();
   page_ = std::move(page_after);
   trail_.sent(resend_trail);
   last_ = scene;

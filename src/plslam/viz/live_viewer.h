@@ -140,8 +140,11 @@ inline constexpr double kPageMinMove = 5e-3;
 // ("trajectory", replacing the page's) when `trail_sent` is empty.
 // `page_after`, when given, receives what the page holds once it applied the delta: `after`, but
 // with what was not sent where the page has it, so that small moves add up until one is sent.
+// `page_info`, when given, is the info the page got last: the local map is left out when it is
+// the same (its ids, thousands of them, change with keyframes, not with every update), and the
+// page keeps the one it has.
 nlohmann::json scene_delta(const map::MapSnapshot& page, const map::MapSnapshot& after, const SceneInfo& info,
                            std::optional<std::size_t> trail_sent, long revision, double min_move_m = kPageMinMove,
-                           map::MapSnapshot* page_after = nullptr);
+                           map::MapSnapshot* page_after = nullptr, const SceneInfo* page_info = nullptr);
 
 }  // namespace plslam::viz
