@@ -64,9 +64,9 @@ std::shared_ptr<map::FrameData> FrameExtractor::extract(long frame_id, double ti
     // This thread takes chunk 0, the lines, at once; if the worker is slow to wake, this thread
     // also runs the points when done. WorkerPool rather than TBB: its hand-over is a mutex and a
     // condition variable, which ThreadSanitizer sees (libtbb is not instrumented).
-    const auto points_lane = [&] {
-      pl = left_orb_.extract(left, &tl);
-      pr = right_orb_.extract(right);
+    const auto left_points = [&] { pl = left_orb_.extract(left, &tl); };
+    const auto right_points = [&] { pr = right_orb_.extract(right); };
+    const auto match_points = [&] {
       const auto s = std::chrono::steady_clock::now();
       sp = matching::match_stereo_points(pl, pr, options_.stereo_points);
       sp_ms = ms_since(s);
@@ -87,23 +87,17 @@ std::shared_ptr<map::FrameData> FrameExtractor::extract(long frame_id, double ti
         if (c == 0) {
           lines_lane();
         } else if (c == 1) {
-          points_lane();
+          left_points();
+          right_points();
+          match_points();
         } else {
           lr = features::extract_lines(right, options_.line_extractor);
         }
       });
     } else {
       // Without lines the two images' points are the lanes.
-      lanes_->run(2, [&](int c) {
-        if (c == 0) {
-          pl = left_orb_.extract(left, &tl);
-        } else {
-          pr = right_orb_.extract(right);
-        }
-      });
-      const auto s = std::chrono::steady_clock::now();
-      sp = matching::match_stereo_points(pl, pr, options_.stereo_points);
-      sp_ms = ms_since(s);
+      lanes_->run(2, [&](int c) { c == 0 ? left_points() : right_points(); });
+      match_points();
     }
   }
   const auto t1 = std::chrono::steady_clock::now();
