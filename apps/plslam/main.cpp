@@ -1,5 +1,7 @@
 // plslam: one binary, one subcommand per task. Exit codes: 0 success, 2 bad usage or
 // bad input, 1 internal error.
+#include <malloc.h>
+
 #include <algorithm>
 #include <exception>
 #include <iostream>
@@ -12,7 +14,23 @@
 #include "plslam/core/log.h"
 #include "plslam/core/version.h"
 
+namespace {
+
+// Each frame allocates and frees buffers of image size (gradients, pyramids, the region grower's
+// masks) and each keyframe the local BA's blocks. With glibc's defaults the threads' arenas give
+// those pages back to the kernel and fault them in again next time: 226,000 page faults in a
+// sequential run of the 300-frame street loop, 62,000 with this (3-4 % of its CPU time). Freed
+// memory is kept for reuse instead; resident memory then follows the peak working set (+7 MB on
+// KITTI 06). Sanitizer runtimes ignore mallopt.
+void keep_freed_memory_for_reuse() {
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);  // glibc's maximum: blocks up to 32 MB come from the arenas
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);   // return memory to the kernel only beyond 1 GB free
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  keep_freed_memory_for_reuse();
   CLI::App app{"plslam: stereo visual SLAM with points and lines"};
   app.set_version_flag("--version", std::string("plslam ") + plslam::kVersion);
   app.require_subcommand(1);
