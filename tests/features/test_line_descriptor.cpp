@@ -1,5 +1,6 @@
 // LBD: matching under a small viewpoint change (homography warp of real and synthetic images).
 #include <cstdio>
+#include <random>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -7,6 +8,7 @@
 
 #include "features/line_synthetic_scene.h"
 #include "plslam/features/orb_descriptor.h"
+#include "plslam/features/line_descriptor.h"
 #include "plslam/features/line_extractor.h"
 #include "support/test_support.h"
 
@@ -116,6 +118,41 @@ TEST(LineDescriptor, HammingAndShape) {
       }
     EXPECT_NEAR(m, 1.0, 1e-4);
     EXPECT_NEAR(sd, 1.0, 1e-4);
+  }
+}
+
+// The band sums: the SSE2 code and the portable one give the same floats (so runs are identical
+// on any machine), and both are the sums of the positive and negative parts, to float rounding.
+TEST(LineDescriptor, PositiveNegativeSumsAreExactAndPortable) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> grad(-1020, 1020);
+  std::uniform_real_distribution<float> angle(0.f, 6.2831853f);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int count = 4 * (1 + trial % 6);
+    std::vector<float> gx(static_cast<std::size_t>(count)), gy(gx.size());
+    for (std::size_t k = 0; k < gx.size(); ++k) {
+      gx[k] = static_cast<float>(grad(rng));
+      gy[k] = static_cast<float>(grad(rng));
+    }
+    if (trial % 5 == 0) gx[0] = gy[0] = 0.f;  // padding samples: zero gradient
+    const float t = angle(rng);
+    const cv::Point2f d(std::cos(t), std::sin(t)), n(-d.y, d.x);
+    float fast[4], portable[4];
+    detail::positive_negative_sums(gx.data(), gy.data(), count, n, d, fast);
+    detail::positive_negative_sums_portable(gx.data(), gy.data(), count, n, d, portable);
+    double expect[4] = {0, 0, 0, 0};
+    for (std::size_t k = 0; k < gx.size(); ++k) {
+      const double dp = double(gx[k]) * n.x + double(gy[k]) * n.y, dl = double(gx[k]) * d.x + double(gy[k]) * d.y;
+      expect[0] += std::max(dp, 0.0);
+      expect[1] += std::max(-dp, 0.0);
+      expect[2] += std::max(dl, 0.0);
+      expect[3] += std::max(-dl, 0.0);
+    }
+    for (int c = 0; c < 4; ++c) {
+      EXPECT_EQ(fast[c], portable[c]) << "trial " << trial << " sum " << c;
+      EXPECT_NEAR(fast[c], expect[c], 1e-5 * (1.0 + expect[c])) << "trial " << trial << " sum " << c;
+      EXPECT_GE(fast[c], 0.f);
+    }
   }
 }
 

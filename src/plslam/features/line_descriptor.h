@@ -32,4 +32,13 @@ cv::Mat describe_lines(const LineGradient& gradient, const std::vector<LineSegme
 cv::Mat describe_lines_float(const LineGradient& gradient, const std::vector<LineSegment>& segments,
                              const LbdOptions& options = {});
 
+namespace detail {
+// Sums over `count` samples (a multiple of 4) of the positive and negative parts of the gradient
+// across the line (dp = g . n) and along it (dl = g . d): sums = (dp+, dp-, dl+, dl-). The second
+// is the portable code the first falls back to without SSE2; both give the same floats.
+void positive_negative_sums(const float* gx, const float* gy, int count, cv::Point2f n, cv::Point2f d, float sums[4]);
+void positive_negative_sums_portable(const float* gx, const float* gy, int count, cv::Point2f n, cv::Point2f d,
+                                     float sums[4]);
+}  // namespace detail
+
 }  // namespace plslam::features
