@@ -1,6 +1,7 @@
 #include "plslam/features/line_detector.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <stdexcept>
 
@@ -124,9 +125,13 @@ std::vector<LineSegment> grow_line_segments(const LineGradient& g, const LineDet
     float cx = sx, cy = sy;  // unit mean gradient direction of the region
     for (std::size_t k = 0; k < region.size(); ++k) {
       const int p = region[k];
-      for (const int off : offsets) {
-        const int q = p + off;
-        if (status[q]) continue;
+      // The free neighbours first, as a bit mask, then only those in the offsets' order: most
+      // neighbours are taken or weak, and testing each with a branch mispredicted often (the
+      // growth was 80 % of line detection). The order, and so the region, is unchanged.
+      unsigned free_mask = 0;
+      for (int i = 0; i < 8; ++i) free_mask |= static_cast<unsigned>(status[p + offsets[i]] == 0) << i;
+      for (; free_mask != 0; free_mask &= free_mask - 1) {
+        const int q = p + offsets[std::countr_zero(free_mask)];
         // Angle test without a division: g . c >= cos(tol) |g|.
         if (gx[q] * cx + gy[q] * cy < cos_tol * mag[q]) continue;
         status[q] = 1;
