@@ -54,6 +54,8 @@ void check_motion(const Eigen::Vector3d& motion, double noise, std::mt19937& rng
     const Eigen::Vector3d v = H * Eigen::Vector3d(x1[static_cast<std::size_t>(i)].x(), x1[static_cast<std::size_t>(i)].y(), 1.0);
     if (index.ray(v, &ray)) {
       index.query(ray, &out);
+      ASSERT_TRUE(index.along_segment(ray, x2[static_cast<std::size_t>(i)], noise + 1e-9))
+          << "point " << i << " off its segment, motion " << motion.transpose();
     } else {
       index.query_all(&out);
     }
@@ -89,6 +91,31 @@ TEST(EpipolarIndex, ForwardMotionReadsAFewPercent) {
   check_motion({1.0, 0, 0.2}, 2.0, rng, &share);
   RecordProperty("share_oblique", std::to_string(share));
   EXPECT_LT(share, 0.04);
+}
+
+// Camera 2 one metre ahead of camera 1: a ray's points in front of camera 2 project from its
+// vanishing point (here the pixel itself) outwards; the epipolar line's part between the epipole
+// and the vanishing point, and behind the epipole, holds no match.
+TEST(EpipolarIndex, ForwardMotionSegmentStartsAtTheVanishingPoint) {
+  Eigen::Matrix3d K;
+  K << 707, 0, 601, 0, 707, 183, 0, 0, 1;
+  const Eigen::Vector3d t21(0, 0, -1);  // camera 1's centre seen from camera 2
+  const Eigen::Vector2d e(601, 183), x1(800, 250);
+  const EpipolarIndex index({x1}, K * t21, 2.0);
+  EpipolarIndex::Ray ray;
+  ASSERT_TRUE(index.ray(Eigen::Vector3d(x1.x(), x1.y(), 1.0), &ray));
+  EXPECT_NEAR(ray.start, (x1 - e).norm(), 1e-9);
+  EXPECT_TRUE(std::isinf(ray.length));
+  for (const double depth : {1.5, 3.0, 10.0, 100.0}) {
+    const Eigen::Vector3d X = depth * K.inverse() * Eigen::Vector3d(x1.x(), x1.y(), 1.0) + t21;
+    EXPECT_TRUE(index.along_segment(ray, project(K, X), 2.0)) << "depth " << depth;
+  }
+  EXPECT_TRUE(index.along_segment(ray, x1 - 1.5 * (x1 - e).normalized(), 2.0));  // within the band
+  EXPECT_FALSE(index.along_segment(ray, e + 0.5 * (x1 - e), 2.0));               // before the start
+  EXPECT_FALSE(index.along_segment(ray, e - (x1 - e), 2.0));                     // behind the epipole
+  // Looking backwards (the ray's third component negative) nothing is in front of camera 2.
+  ASSERT_TRUE(index.ray(Eigen::Vector3d(-x1.x(), -x1.y(), -1.0), &ray));
+  EXPECT_FALSE(index.along_segment(ray, x1, 2.0));
 }
 
 TEST(EpipolarIndex, EpipoleAtInfinityReturnsAll) {

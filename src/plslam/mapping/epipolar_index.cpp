@@ -59,6 +59,11 @@ bool EpipolarIndex::ray(const Eigen::Vector3d& v, Ray* out) const {
   // distance to the vanishing point; otherwise it is unbounded.
   out->length = std::numeric_limits<double>::infinity();
   if (ew > 0 && v.z() > 0) out->length = n / v.z();
+  // Camera 1 behind camera 2 (e_w < 0, forward motion): only depths with z v_w + e_w > 0 are in
+  // front of camera 2, and their distance falls from infinity to |d| / v_w as z grows, so the
+  // segment runs outwards from the vanishing point; with v_w <= 0 no depth is in front.
+  out->start = 0.0;
+  if (ew < 0) out->start = v.z() > 0 ? n / v.z() : std::numeric_limits<double>::infinity();
   return true;
 }
 
@@ -76,6 +81,7 @@ void EpipolarIndex::query(const Ray& ray, std::vector<int>* out) const {
   const double theta = ray.angle;
   for (std::size_t k = 0; k < rings_.size(); ++k) {
     if (inner_[k] > ray.length + band_) break;  // beyond the vanishing point
+    if (k + 1 < inner_.size() && inner_[k + 1] < ray.start - band_) continue;  // before the segment
     const auto& ring = rings_[k];
     if (ring.empty()) continue;
     const double window = window_[k];

@@ -29,8 +29,16 @@ class EpipolarIndex {
     Eigen::Vector2d direction;  // from the epipole, unit length
     double angle;               // of the direction, in (-pi, pi]
     double length;              // distance from the epipole to the vanishing point (inf: none)
+    double start = 0;           // distance from the epipole where points in front of camera 2 begin
   };
   bool ray(const Eigen::Vector3d& v, Ray* out) const;
+
+  // Whether image-2 point `p` lies along the ray's segment, `band` pixels beyond its ends allowed
+  // (its distance across is the caller's epipolar test).
+  bool along_segment(const Ray& ray, const Eigen::Vector2d& p, double band) const {
+    const double t = (p - epipole_).dot(ray.direction);
+    return t >= ray.start - band && t <= ray.length + band;
+  }
 
   // Indices (into `points`) of every point within `band` pixels of the ray's segment, and
   // possibly a few more; the caller applies its exact test. No duplicates, in no particular order
