@@ -1,5 +1,8 @@
 // plslam/plslam.h: what an embedding program sees.
+#include <unistd.h>
+
 #include <fstream>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -12,16 +15,27 @@
 namespace plslam {
 namespace {
 
-// 60 frames of the rendered office (EuRoC layout, exact ground truth), once per test process.
+// 60 frames of the rendered office (EuRoC layout, exact ground truth), rendered once per build.
+// ctest runs each test as its own process, and two may get here at once: each renders into its own
+// folder and renames it into place, so the shared folder is either absent or whole.
 const std::filesystem::path& api_sequence() {
   static const std::filesystem::path dir = [] {
     const auto d = test::artifacts_dir() / "public_api_office60";
-    if (!std::filesystem::exists(d / "mav0/synth/synth.json")) {
-      std::filesystem::remove_all(d);
-      const auto r = test::run_cli("synth --out \"" + d.string() + "\" --scene office --preset euroc --frames 60 --seed 1");
-      EXPECT_EQ(r.exit_code, 0) << r.err;
+    const auto whole = [](const std::filesystem::path& p) { return std::filesystem::exists(p / "mav0/synth/synth.json"); };
+    if (whole(d)) return d;
+    auto own = d;
+    own += ".part-" + std::to_string(::getpid());
+    std::filesystem::remove_all(own);
+    const auto r = test::run_cli("synth --out \"" + own.string() + "\" --scene office --preset euroc --frames 60 --seed 1");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    std::error_code ec;
+    std::filesystem::rename(own, d, ec);
+    if (!ec) return d;
+    if (whole(d)) {  // another process renamed its copy first
+      std::filesystem::remove_all(own);
+      return d;
     }
-    return d;
+    return own;  // something else is in the way: use this process's copy
   }();
   return dir;
 }
