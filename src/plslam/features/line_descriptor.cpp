@@ -14,6 +14,12 @@
 namespace plslam::features {
 
 namespace detail {
+namespace {
+// The one fixed order in which both versions add their four lanes.
+void add_lanes(const float lanes[4][4], float sums[4]) {
+  for (int c = 0; c < 4; ++c) sums[c] = (lanes[c][0] + lanes[c][1]) + (lanes[c][2] + lanes[c][3]);
+}
+}  // namespace
 
 // Four lanes, each adding every fourth sample, combined in a fixed order: the SSE2 and the
 // portable code give the same floats. With one chain of additions per sum the loop was
@@ -32,7 +38,7 @@ void positive_negative_sums_portable(const float* gx, const float* gy, int count
       lanes[3][l] += 0.f - dl > 0.f ? 0.f - dl : 0.f;
     }
   }
-  for (int c = 0; c < 4; ++c) sums[c] = (lanes[c][0] + lanes[c][1]) + (lanes[c][2] + lanes[c][3]);
+  add_lanes(lanes, sums);
 }
 
 void positive_negative_sums(const float* gx, const float* gy, int count, cv::Point2f n, cv::Point2f d,
@@ -55,7 +61,7 @@ void positive_negative_sums(const float* gx, const float* gy, int count, cv::Poi
   _mm_storeu_ps(lanes[1], s1);
   _mm_storeu_ps(lanes[2], s2);
   _mm_storeu_ps(lanes[3], s3);
-  for (int c = 0; c < 4; ++c) sums[c] = (lanes[c][0] + lanes[c][1]) + (lanes[c][2] + lanes[c][3]);
+  add_lanes(lanes, sums);
 #else
   positive_negative_sums_portable(gx, gy, count, n, d, sums);
 #endif
