@@ -2,6 +2,9 @@
 // keypoints that get a depth on real KITTI 06 and EuRoC frames.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -174,6 +177,69 @@ double depth_share_on_first_frame(const std::filesystem::path& seq, int n_featur
   std::nth_element(depths.begin(), depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2), depths.end());
   *median_depth = depths.empty() ? 0.0 : depths[depths.size() / 2];
   return static_cast<double>(f.stereo.matched) / static_cast<double>(f.left.keypoints.size());
+}
+
+// The SAD curve from its definition, written out here: the sum over the window of |l - r - o|,
+// with o the rounded difference of the window means.
+std::vector<int> sad_by_definition(const cv::Mat& l, int xl, int y, const cv::Mat& r, int xr0, int hw, int search) {
+  const int n = (2 * hw + 1) * (2 * hw + 1);
+  std::vector<int> out;
+  for (int s = -search; s <= search; ++s) {
+    long sum_l = 0, sum_r = 0;
+    for (int dy = -hw; dy <= hw; ++dy)
+      for (int dx = -hw; dx <= hw; ++dx) {
+        sum_l += l.at<uchar>(y + dy, xl + dx);
+        sum_r += r.at<uchar>(y + dy, xr0 + s + dx);
+      }
+    const long diff = sum_l - sum_r;
+    const long o = (diff + (diff >= 0 ? n / 2 : -n / 2)) / n;
+    int total = 0;
+    for (int dy = -hw; dy <= hw; ++dy)
+      for (int dx = -hw; dx <= hw; ++dx)
+        total += static_cast<int>(std::labs(l.at<uchar>(y + dy, xl + dx) - r.at<uchar>(y + dy, xr0 + s + dx) - o));
+    out.push_back(total);
+  }
+  return out;
+}
+
+TEST(StereoPoints, SadCurveLanesEqualTheDefinition) {
+  std::mt19937 rng(7);
+  cv::Mat left(64, 96, CV_8U), right(64, 96, CV_8U);
+  // Random texture, and in the top-left corner a black and white checkerboard against its
+  // inverse: there the sums reach their bound (255 per pixel), which the 16-bit lanes must hold.
+  cv::randu(left, 0, 256);
+  cv::randu(right, 0, 256);
+  for (int y = 0; y < 24; ++y)
+    for (int x = 0; x < 40; ++x) {
+      const bool white = (x + y) % 2 == 0;
+      if (x < 24) left.at<uchar>(y, x) = white ? 255 : 0;
+      right.at<uchar>(y, x) = white ? 0 : 255;
+    }
+  int checked = 0;
+  for (const auto& [hw, search] : {std::pair{5, 5}, std::pair{3, 2}, std::pair{5, 9}, std::pair{7, 5}, std::pair{1, 1}}) {
+    std::uniform_int_distribution<int> x(hw + search + 2, 96 - hw - search - 3), yy(hw, 63 - hw);
+    std::vector<std::pair<int, int>> places = {{10, 10}, {hw + 1, hw}};  // the white/black corner
+    for (int i = 0; i < 40; ++i) places.emplace_back(x(rng), yy(rng));
+    for (const auto& [xl, y] : places) {
+      const int xr0 = std::clamp(xl + static_cast<int>(rng() % 7) - 3, hw + search, 95 - hw - search);
+      const auto expected = sad_by_definition(left, xl, y, right, xr0, hw, search);
+      for (const auto code : {detail::SadCode::kAuto, detail::SadCode::kSse2, detail::SadCode::kPlain}) {
+        std::vector<int> sad(expected.size());
+        detail::zero_mean_sad_curve(left, xl, y, right, xr0, hw, search, code, sad.data());
+        ASSERT_EQ(sad, expected) << "code " << static_cast<int>(code) << " hw " << hw << " search " << search
+                                 << " at " << xl << "," << y;
+      }
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 5 * 42);
+  // The corner: at shift 0 every pixel differs by 255 and the means by about 2, so the sum is
+  // close to 121 * 255; one pixel either way the patterns agree and the sum is 0.
+  std::vector<int> corner(11);
+  detail::zero_mean_sad_curve(left, 10, 10, right, 10, 5, 5, detail::SadCode::kAuto, corner.data());
+  EXPECT_GE(corner[5], 120 * 255);
+  EXPECT_EQ(corner[4], 0);
+  EXPECT_EQ(corner[6], 0);
 }
 
 TEST(StereoPoints, Kitti06MostLeftKeypointsGetDepth) {

@@ -3,7 +3,12 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #include "plslam/core/error.h"
 #include "plslam/features/orb_descriptor.h"
@@ -23,30 +28,99 @@ void StereoPointOptions::validate() const {
 
 namespace {
 
+constexpr int kLanes = 16;  // shifts evaluated together: 16-bit lanes of one AVX2 register
+
+// SAD at kLanes consecutive shifts: lane k sums |left(r, c) - right(r, c + k) - offset[k]| over
+// the window. The shifts are the vector lanes, so no sum is reduced across a register. Each term
+// is at most 510, so a window of at most 11 x 11 keeps every sum below 2^16, and the lanes are 16
+// bits wide (the caller checks the window size; the sums are read as unsigned).
+#if defined(__x86_64__)
+void sad_lanes_sse2(const int16_t* left, int win, const int16_t* right, int stride, const int16_t* offset,
+                    uint16_t* out) {
+  const __m128i off0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(offset));
+  const __m128i off1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(offset + 8));
+  const __m128i zero = _mm_setzero_si128();
+  __m128i acc0 = zero, acc1 = zero;
+  for (int r = 0; r < win; ++r) {
+    for (int c = 0; c < win; ++c) {
+      const __m128i a = _mm_set1_epi16(left[r * win + c]);
+      const int16_t* b = right + r * stride + c;
+      __m128i d0 = _mm_sub_epi16(_mm_sub_epi16(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(b))), off0);
+      __m128i d1 = _mm_sub_epi16(_mm_sub_epi16(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + 8))), off1);
+      d0 = _mm_max_epi16(d0, _mm_sub_epi16(zero, d0));  // |d|: SSE2 has no abs for 16-bit lanes
+      d1 = _mm_max_epi16(d1, _mm_sub_epi16(zero, d1));
+      acc0 = _mm_add_epi16(acc0, d0);
+      acc1 = _mm_add_epi16(acc1, d1);
+    }
+  }
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out), acc0);
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 8), acc1);
+}
+
+// All 16 lanes in one register, chosen by a flag set at start-up as in features::hamming_distance.
+__attribute__((target("avx2"))) void sad_lanes_avx2(const int16_t* left, int win, const int16_t* right, int stride,
+                                                     const int16_t* offset, uint16_t* out) {
+  const __m256i off = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(offset));
+  __m256i acc = _mm256_setzero_si256();
+  for (int r = 0; r < win; ++r) {
+    for (int c = 0; c < win; ++c) {
+      const __m256i a = _mm256_sub_epi16(_mm256_set1_epi16(left[r * win + c]), off);
+      const __m256i b = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(right + r * stride + c));
+      acc = _mm256_add_epi16(acc, _mm256_abs_epi16(_mm256_sub_epi16(a, b)));
+    }
+  }
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), acc);
+}
+const bool kHasAvx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
+#endif
+
+// `widest`: AVX2 where the CPU has it; otherwise the baseline (SSE2) code.
+void sad_lanes(bool widest, const int16_t* left, int win, const int16_t* right, int stride, const int16_t* offset,
+               uint16_t* out) {
+#if defined(__x86_64__)
+  if (widest && kHasAvx2) return sad_lanes_avx2(left, win, right, stride, offset, out);
+  return sad_lanes_sse2(left, win, right, stride, offset, out);
+#else
+  (void)widest;
+  uint16_t acc[kLanes] = {};
+  for (int r = 0; r < win; ++r)
+    for (int c = 0; c < win; ++c)
+      for (int k = 0; k < kLanes; ++k)
+        acc[k] = static_cast<uint16_t>(acc[k] + std::abs(left[r * win + c] - right[r * stride + c + k] - offset[k]));
+  std::copy(acc, acc + kLanes, out);
+#endif
+}
+
 // SAD of the left window against the right window at each of the 2L+1 shifts around xr0,
 // after removing the difference of the window means (robust to a gain offset between the
-// cameras). Windows are copied once into small buffers so each shift is a tight loop.
+// cameras). Windows are copied once into small 16-bit buffers; the right one is padded with
+// zeros so that every block of kLanes shifts reads inside it.
 class SadCurve {
  public:
-  SadCurve(int half_window, int search)
+  SadCurve(int half_window, int search, detail::SadCode code)
       : hw_(half_window), L_(search), win_(2 * half_window + 1), strip_(2 * search + win_),
-        left_(static_cast<std::size_t>(win_ * win_)), right_(static_cast<std::size_t>(win_ * strip_)),
-        colsum_(static_cast<std::size_t>(strip_)) {}
+        blocks_((2 * search + 1 + kLanes - 1) / kLanes),
+        stride_(std::max(strip_, win_ - 1 + blocks_ * kLanes)),
+        lanes_(code != detail::SadCode::kPlain && win_ * win_ * 510 <= 65535), widest_(code == detail::SadCode::kAuto),
+        left_(static_cast<std::size_t>(win_ * win_)), right_(static_cast<std::size_t>(win_ * stride_), 0),
+        offset_(static_cast<std::size_t>(blocks_ * kLanes), 0), colsum_(static_cast<std::size_t>(strip_)) {}
 
   void compute(const cv::Mat& il, int xl, int y, const cv::Mat& ir, int xr0, int* sad) {
     int sum_l = 0;
     for (int r = 0; r < win_; ++r) {
       const uchar* pl = il.ptr<uchar>(y - hw_ + r) + xl - hw_;
       const uchar* pr = ir.ptr<uchar>(y - hw_ + r) + xr0 - L_ - hw_;
+      int16_t* ql = left_.data() + r * win_;
+      int16_t* qr = right_.data() + r * stride_;
       for (int c = 0; c < win_; ++c) {
-        left_[static_cast<std::size_t>(r * win_ + c)] = pl[c];
+        ql[c] = pl[c];
         sum_l += pl[c];
       }
-      for (int c = 0; c < strip_; ++c) right_[static_cast<std::size_t>(r * strip_ + c)] = pr[c];
+      for (int c = 0; c < strip_; ++c) qr[c] = pr[c];
     }
     for (int c = 0; c < strip_; ++c) {
       int s = 0;
-      for (int r = 0; r < win_; ++r) s += right_[static_cast<std::size_t>(r * strip_ + c)];
+      for (int r = 0; r < win_; ++r) s += right_[static_cast<std::size_t>(r * stride_ + c)];
       colsum_[static_cast<std::size_t>(c)] = s;
     }
     const int n = win_ * win_;
@@ -55,11 +129,25 @@ class SadCurve {
     for (int k = 0; k <= 2 * L_; ++k) {
       if (k > 0) sum_r += colsum_[static_cast<std::size_t>(k + win_ - 1)] - colsum_[static_cast<std::size_t>(k - 1)];
       const int diff = sum_l - sum_r;
-      const int offset = (diff + (diff >= 0 ? n / 2 : -n / 2)) / n;
+      offset_[static_cast<std::size_t>(k)] = static_cast<int16_t>((diff + (diff >= 0 ? n / 2 : -n / 2)) / n);
+    }
+    if (lanes_) {
+      alignas(32) uint16_t lanes[kLanes];
+      for (int b = 0; b < blocks_; ++b) {
+        const int16_t* right = right_.data() + b * kLanes;
+        const int16_t* offset = offset_.data() + b * kLanes;
+        sad_lanes(widest_, left_.data(), win_, right, stride_, offset, lanes);
+        for (int k = b * kLanes; k < std::min((b + 1) * kLanes, 2 * L_ + 1); ++k) sad[k] = lanes[k - b * kLanes];
+      }
+      return;
+    }
+    // Windows too large for 16-bit sums: one shift at a time in 32 bits.
+    for (int k = 0; k <= 2 * L_; ++k) {
+      const int offset = offset_[static_cast<std::size_t>(k)];
       int total = 0;
       for (int r = 0; r < win_; ++r) {
-        const int* pl = left_.data() + r * win_;
-        const int* pr = right_.data() + r * strip_ + k;
+        const int16_t* pl = left_.data() + r * win_;
+        const int16_t* pr = right_.data() + r * stride_ + k;
         for (int c = 0; c < win_; ++c) total += std::abs(pl[c] - pr[c] - offset);
       }
       sad[k] = total;
@@ -67,11 +155,20 @@ class SadCurve {
   }
 
  private:
-  int hw_, L_, win_, strip_;
-  std::vector<int> left_, right_, colsum_;
+  int hw_, L_, win_, strip_, blocks_, stride_;
+  bool lanes_, widest_;
+  std::vector<int16_t> left_, right_, offset_;
+  std::vector<int> colsum_;
 };
 
 }  // namespace
+
+namespace detail {
+void zero_mean_sad_curve(const cv::Mat& left, int xl, int y, const cv::Mat& right, int xr0, int half_window,
+                         int search, SadCode code, int* sad) {
+  SadCurve(half_window, search, code).compute(left, xl, y, right, xr0, sad);
+}
+}  // namespace detail
 
 StereoPointMatches match_stereo_points(const features::PointFeatures& left,
                                        const features::PointFeatures& right,
@@ -112,7 +209,7 @@ StereoPointMatches match_stereo_points(const features::PointFeatures& left,
 
   const int hw = o.sad_half_window, L = o.sad_search;
   std::vector<int> sad(static_cast<std::size_t>(2 * L + 1));
-  SadCurve curve(hw, L);
+  SadCurve curve(hw, L, detail::SadCode::kAuto);
   std::vector<std::pair<int, std::size_t>> sad_of_match;  // (SAD, left index)
   sad_of_match.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {

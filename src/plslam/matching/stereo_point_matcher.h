@@ -48,4 +48,18 @@ StereoPointMatches match_stereo_points(const features::PointFeatures& left,
                                        const features::PointFeatures& right,
                                        const StereoPointOptions& options);
 
+namespace detail {
+// Which code computes the SAD curve: 16-bit lanes, one per shift, in AVX2 where the CPU has it
+// (kAuto, what matching uses) or in the baseline SSE2 code (kSse2), for windows up to 11 x 11;
+// or plain 32-bit code (kPlain, and any larger window). All give the same integers.
+enum class SadCode { kAuto, kSse2, kPlain };
+
+// The SAD curve match_stereo_points refines with: for each shift s in [-search, search], the sum
+// over the (2 half_window + 1)^2 window at (xl, y) in `left` of |left - right(x + xr0 - xl + s) -
+// offset_s|, where offset_s is the rounded difference of the two windows' means; into
+// sad[s + search].
+void zero_mean_sad_curve(const cv::Mat& left, int xl, int y, const cv::Mat& right, int xr0, int half_window,
+                         int search, SadCode code, int* sad);
+}  // namespace detail
+
 }  // namespace plslam::matching
