@@ -56,6 +56,24 @@ TEST(FastGaussian, MatchesOpenCvGaussianBlurWithinTwoGreyLevels) {
   EXPECT_THROW(gaussian_blur_7x7(flat, cv::Rect(2, 3, 44, 44), ours), std::invalid_argument);
 }
 
+TEST(FastGaussian, BaselineAndDispatchedCodeGiveTheSameBytes) {
+  // Random noise reaches every sum the 16-bit lanes hold; odd widths leave vector remainders.
+  cv::Mat img(123, 301, CV_8U);
+  cv::randu(img, 0, 256);
+  img(cv::Rect(0, 0, 40, 40)).setTo(255);
+  for (const cv::Rect rect : {cv::Rect(3, 3, 295, 117), cv::Rect(5, 4, 17, 9), cv::Rect(3, 3, 1, 1)}) {
+    cv::Mat dispatched, baseline;
+    gaussian_blur_7x7(img, rect, dispatched);
+    detail::gaussian_blur_7x7_baseline(img, rect, baseline);
+    ASSERT_EQ(dispatched.size(), rect.size());
+    EXPECT_EQ(cv::norm(dispatched, baseline, cv::NORM_INF), 0.0) << rect;
+  }
+  // Saturated input stays saturated: the largest sums do not wrap.
+  cv::Mat white;
+  gaussian_blur_7x7(img, cv::Rect(3, 3, 30, 30), white);
+  EXPECT_EQ(cv::countNonZero(white != 255), 0);
+}
+
 TEST(OrbDescriptor, PatternIsDeterministicBoundedAndNonDegenerate) {
   const auto& p = brief_pattern();
   int left_of_centre = 0;

@@ -10,4 +10,10 @@ namespace plslam::features {
 // inside `src`: they serve as the filter's border (a padded pyramid level provides them).
 void gaussian_blur_7x7(const cv::Mat& src, const cv::Rect& rect, cv::Mat& dst);
 
+namespace detail {
+// The same blur compiled for baseline x86-64 only; gaussian_blur_7x7 runs an AVX2 build of the
+// same code where the CPU has it. Both give the same bytes.
+void gaussian_blur_7x7_baseline(const cv::Mat& src, const cv::Rect& rect, cv::Mat& dst);
+}  // namespace detail
+
 }  // namespace plslam::features
