@@ -1,8 +1,11 @@
 // Pyramid, orientation, BRIEF pattern, the ORB extractor end to end, and descriptor invariance
 // to rotation and scale.
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <functional>
+#include <random>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -99,6 +102,31 @@ TEST(OrbDescriptor, IntensityCentroidPointsToTheBrightSide) {
   img.setTo(20);
   img(cv::Rect(0, 0, 31, 64)).setTo(200);  // bright left -> 180 degrees
   EXPECT_NEAR(intensity_centroid_angle(img, 32, 32), 180.0, 3.0);
+}
+
+TEST(OrbDescriptor, BaselineAndDispatchedCodeGiveTheSameResults) {
+  cv::Mat img(120, 160, CV_8U);
+  cv::randu(img, 0, 256);
+  cv::Mat blurred;
+  gaussian_blur_7x7(img, cv::Rect(3, 3, 154, 114), blurred);
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> coord(20, 90);
+  int bits_set = 0;
+  for (int i = 0; i < 200; ++i) {
+    const int x = coord(rng) + 20, y = coord(rng);
+    const float angle = intensity_centroid_angle(img, x, y);
+    ASSERT_EQ(angle, detail::intensity_centroid_angle_baseline(img, x, y)) << x << "," << y;
+    // Any angle, not only the centroid's: each rotation rounds the pattern differently.
+    for (const float a : {angle, 0.f, 37.5f, 359.9f}) {
+      uint8_t dispatched[32], baseline[32];
+      brief_descriptor(blurred, x, y, a, dispatched);
+      detail::brief_descriptor_baseline(blurred, x, y, a, baseline);
+      ASSERT_EQ(std::memcmp(dispatched, baseline, 32), 0) << x << "," << y << " angle " << a;
+      for (const uint8_t b : dispatched) bits_set += std::popcount(b);
+    }
+  }
+  // Random texture: about half the tests come out set.
+  EXPECT_NEAR(bits_set / (200.0 * 4 * 256), 0.5, 0.05);
 }
 
 TEST(OrbDescriptor, HammingDistance) {

@@ -59,7 +59,12 @@ const std::array<std::array<int8_t, 4>, 256>& brief_pattern() {
   return pattern;
 }
 
-float intensity_centroid_angle(const cv::Mat& image, int x, int y) {
+namespace {
+
+// The orientation and the descriptor are written once and compiled twice: for baseline x86-64
+// and for AVX2 (twice the vector width for the disc's sums and the pattern's rotation), chosen
+// by a flag set at start-up as hamming_distance does below. Without FMA both round alike.
+[[gnu::always_inline]] inline float centroid_angle_impl(const cv::Mat& image, int x, int y) {
   // Every row of the disc as 32 weights over u = -15..16 (zero outside the disc), so each row is
   // one fixed-length multiply-accumulate the compiler vectorises.
   struct Disc {
@@ -96,7 +101,7 @@ float intensity_centroid_angle(const cv::Mat& image, int x, int y) {
   return cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
 }
 
-void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
+[[gnu::always_inline]] inline void brief_impl(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
   // The pattern as float columns, built once: the rotation below then runs as plain vector code.
   struct Columns {
     alignas(32) float x[512], y[512];
@@ -132,6 +137,45 @@ void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uin
     out[byte] = v;
   }
 }
+
+float centroid_angle_baseline(const cv::Mat& image, int x, int y) { return centroid_angle_impl(image, x, y); }
+void brief_baseline(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
+  brief_impl(blurred, x, y, angle_deg, out);
+}
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) float centroid_angle_avx2(const cv::Mat& image, int x, int y) {
+  return centroid_angle_impl(image, x, y);
+}
+__attribute__((target("avx2"))) void brief_avx2(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
+  brief_impl(blurred, x, y, angle_deg, out);
+}
+const bool kHasAvx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
+#endif
+
+}  // namespace
+
+float intensity_centroid_angle(const cv::Mat& image, int x, int y) {
+#if defined(__x86_64__)
+  if (kHasAvx2) return centroid_angle_avx2(image, x, y);
+#endif
+  return centroid_angle_baseline(image, x, y);
+}
+
+void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
+#if defined(__x86_64__)
+  if (kHasAvx2) return brief_avx2(blurred, x, y, angle_deg, out);
+#endif
+  brief_baseline(blurred, x, y, angle_deg, out);
+}
+
+namespace detail {
+float intensity_centroid_angle_baseline(const cv::Mat& image, int x, int y) {
+  return centroid_angle_baseline(image, x, y);
+}
+void brief_descriptor_baseline(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
+  brief_baseline(blurred, x, y, angle_deg, out);
+}
+}  // namespace detail
 
 namespace {
 inline int hamming_impl(const uint8_t* a, const uint8_t* b) {

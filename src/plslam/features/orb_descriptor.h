@@ -31,4 +31,11 @@ void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uin
 // Hamming distance between two 32-byte descriptors.
 int hamming_distance(const uint8_t* a, const uint8_t* b);
 
+namespace detail {
+// The two above compiled for baseline x86-64 only; the public ones run an AVX2 build of the same
+// code where the CPU has it. Both give the same results.
+float intensity_centroid_angle_baseline(const cv::Mat& image, int x, int y);
+void brief_descriptor_baseline(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out);
+}  // namespace detail
+
 }  // namespace plslam::features
