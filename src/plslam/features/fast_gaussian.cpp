@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "plslam/core/cpu_features.h"
+
 namespace plslam::features {
 namespace {
 
@@ -44,33 +46,34 @@ void blur_baseline(const cv::Mat& src, const cv::Rect& rect, uint8_t* tmp, cv::M
   blur_passes(src, rect, tmp, dst);
 }
 #if defined(__x86_64__)
-// Chosen by a flag set at start-up, as features::hamming_distance does.
+// Chosen with core::cpu_has_avx2().
 __attribute__((target("avx2"))) void blur_avx2(const cv::Mat& src, const cv::Rect& rect, uint8_t* tmp, cv::Mat& dst) {
   blur_passes(src, rect, tmp, dst);
 }
-const bool kHasAvx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
 #endif
+
+void check_blur_input(const cv::Mat& src, const cv::Rect& rect) {
+  if (src.type() != CV_8UC1 || rect.x < 3 || rect.y < 3 || rect.x + rect.width + 3 > src.cols ||
+      rect.y + rect.height + 3 > src.rows)
+    throw std::invalid_argument("gaussian_blur_7x7: need 8-bit input with 3 pixels around the rectangle");
+}
 
 }  // namespace
 
 void gaussian_blur_7x7(const cv::Mat& src, const cv::Rect& rect, cv::Mat& dst) {
-  if (src.type() != CV_8UC1 || rect.x < 3 || rect.y < 3 || rect.x + rect.width + 3 > src.cols ||
-      rect.y + rect.height + 3 > src.rows)
-    throw std::invalid_argument("gaussian_blur_7x7: need 8-bit input with 3 pixels around the rectangle");
+  check_blur_input(src, rect);
   dst.create(rect.height, rect.width, CV_8U);
   thread_local std::vector<uint8_t> tmp;
   tmp.resize(static_cast<std::size_t>(rect.width) * static_cast<std::size_t>(rect.height + 6));
 #if defined(__x86_64__)
-  if (kHasAvx2) return blur_avx2(src, rect, tmp.data(), dst);
+  if (core::cpu_has_avx2()) return blur_avx2(src, rect, tmp.data(), dst);
 #endif
   blur_baseline(src, rect, tmp.data(), dst);
 }
 
 namespace detail {
 void gaussian_blur_7x7_baseline(const cv::Mat& src, const cv::Rect& rect, cv::Mat& dst) {
-  if (src.type() != CV_8UC1 || rect.x < 3 || rect.y < 3 || rect.x + rect.width + 3 > src.cols ||
-      rect.y + rect.height + 3 > src.rows)
-    throw std::invalid_argument("gaussian_blur_7x7: need 8-bit input with 3 pixels around the rectangle");
+  check_blur_input(src, rect);
   dst.create(rect.height, rect.width, CV_8U);
   std::vector<uint8_t> tmp(static_cast<std::size_t>(rect.width) * static_cast<std::size_t>(rect.height + 6));
   blur_baseline(src, rect, tmp.data(), dst);

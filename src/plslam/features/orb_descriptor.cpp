@@ -6,6 +6,8 @@
 
 #include <opencv2/core/fast_math.hpp>
 
+#include "plslam/core/cpu_features.h"
+
 namespace plslam::features {
 namespace {
 
@@ -63,7 +65,7 @@ namespace {
 
 // The orientation and the descriptor are written once and compiled twice: for baseline x86-64
 // and for AVX2 (twice the vector width for the disc's sums and the pattern's rotation), chosen
-// by a flag set at start-up as hamming_distance does below. Without FMA both round alike.
+// with core::cpu_has_avx2(). Without FMA both round alike.
 [[gnu::always_inline]] inline float centroid_angle_impl(const cv::Mat& image, int x, int y) {
   // Every row of the disc as 32 weights over u = -15..16 (zero outside the disc), so each row is
   // one fixed-length multiply-accumulate the compiler vectorises.
@@ -149,21 +151,20 @@ __attribute__((target("avx2"))) float centroid_angle_avx2(const cv::Mat& image, 
 __attribute__((target("avx2"))) void brief_avx2(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
   brief_impl(blurred, x, y, angle_deg, out);
 }
-const bool kHasAvx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
 #endif
 
 }  // namespace
 
 float intensity_centroid_angle(const cv::Mat& image, int x, int y) {
 #if defined(__x86_64__)
-  if (kHasAvx2) return centroid_angle_avx2(image, x, y);
+  if (core::cpu_has_avx2()) return centroid_angle_avx2(image, x, y);
 #endif
   return centroid_angle_baseline(image, x, y);
 }
 
 void brief_descriptor(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
 #if defined(__x86_64__)
-  if (kHasAvx2) return brief_avx2(blurred, x, y, angle_deg, out);
+  if (core::cpu_has_avx2()) return brief_avx2(blurred, x, y, angle_deg, out);
 #endif
   brief_baseline(blurred, x, y, angle_deg, out);
 }

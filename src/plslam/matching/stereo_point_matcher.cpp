@@ -10,6 +10,7 @@
 #include <immintrin.h>
 #endif
 
+#include "plslam/core/cpu_features.h"
 #include "plslam/core/error.h"
 #include "plslam/features/orb_descriptor.h"
 
@@ -28,7 +29,8 @@ void StereoPointOptions::validate() const {
 
 namespace {
 
-constexpr int kLanes = 16;  // shifts evaluated together: 16-bit lanes of one AVX2 register
+constexpr int kLanes = 16;         // shifts evaluated together: 16-bit lanes of one AVX2 register
+constexpr int kMaxLaneWindow = 11;  // 11 * 11 terms of at most 510 stay below 2^16
 
 // SAD at kLanes consecutive shifts: lane k sums |left(r, c) - right(r, c + k) - offset[k]| over
 // the window. The shifts are the vector lanes, so no sum is reduced across a register. Each term
@@ -57,7 +59,7 @@ void sad_lanes_sse2(const int16_t* left, int win, const int16_t* right, int stri
   _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 8), acc1);
 }
 
-// All 16 lanes in one register, chosen by a flag set at start-up as in features::hamming_distance.
+// All 16 lanes in one register, where core::cpu_has_avx2().
 __attribute__((target("avx2"))) void sad_lanes_avx2(const int16_t* left, int win, const int16_t* right, int stride,
                                                      const int16_t* offset, uint16_t* out) {
   const __m256i off = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(offset));
@@ -71,14 +73,13 @@ __attribute__((target("avx2"))) void sad_lanes_avx2(const int16_t* left, int win
   }
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), acc);
 }
-const bool kHasAvx2 = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
 #endif
 
 // `widest`: AVX2 where the CPU has it; otherwise the baseline (SSE2) code.
 void sad_lanes(bool widest, const int16_t* left, int win, const int16_t* right, int stride, const int16_t* offset,
                uint16_t* out) {
 #if defined(__x86_64__)
-  if (widest && kHasAvx2) return sad_lanes_avx2(left, win, right, stride, offset, out);
+  if (widest && core::cpu_has_avx2()) return sad_lanes_avx2(left, win, right, stride, offset, out);
   return sad_lanes_sse2(left, win, right, stride, offset, out);
 #else
   (void)widest;
@@ -101,7 +102,7 @@ class SadCurve {
       : hw_(half_window), L_(search), win_(2 * half_window + 1), strip_(2 * search + win_),
         blocks_((2 * search + 1 + kLanes - 1) / kLanes),
         stride_(std::max(strip_, win_ - 1 + blocks_ * kLanes)),
-        lanes_(code != detail::SadCode::kPlain && win_ * win_ * 510 <= 65535), widest_(code == detail::SadCode::kAuto),
+        lanes_(code != detail::SadCode::kPlain && win_ <= kMaxLaneWindow), widest_(code == detail::SadCode::kAuto),
         left_(static_cast<std::size_t>(win_ * win_)), right_(static_cast<std::size_t>(win_ * stride_), 0),
         offset_(static_cast<std::size_t>(blocks_ * kLanes), 0), colsum_(static_cast<std::size_t>(strip_)) {}
 
@@ -141,7 +142,7 @@ class SadCurve {
       }
       return;
     }
-    // Windows too large for 16-bit sums: one shift at a time in 32 bits.
+    // kPlain, or a window too large for 16-bit sums: one shift at a time in 32 bits.
     for (int k = 0; k <= 2 * L_; ++k) {
       const int offset = offset_[static_cast<std::size_t>(k)];
       int total = 0;
