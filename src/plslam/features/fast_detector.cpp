@@ -9,6 +9,7 @@
 
 #include <opencv2/features2d.hpp>
 
+#include "plslam/core/cpu_features.h"
 #include "plslam/core/error.h"
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -134,8 +135,7 @@ struct Kernels {
 
 bool cpu_has_avx2() {
 #ifdef PLSLAM_FAST_X86
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
+  return core::cpu_has_avx2();
 #else
   return false;
 #endif

@@ -10,6 +10,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "plslam/core/cpu_features.h"
+
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
@@ -543,8 +545,7 @@ int scan_avx2(const SortedCandidates& sorted, const Grid& grid, uint8_t* g, uint
 
 bool use_avx2() {
 #ifdef PLSLAM_SSC_AVX2
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has && !detail::ssc_portable_only();
+  return core::cpu_has_avx2() && !detail::ssc_portable_only();
 #else
   return false;
 #endif
