@@ -1,6 +1,6 @@
 #include "plslam/mapping/map_ba_problem.h"
 
-#include <unordered_set>
+#include "plslam/core/pointer_set.h"
 
 namespace plslam::mapping {
 
@@ -17,16 +17,19 @@ int MapBaProblem::add_keyframe(map::KeyFrame* kf, bool fixed) {
 }
 
 void MapBaProblem::add_landmarks_of(const std::vector<map::KeyFrame*>& kfs) {
-  std::unordered_set<map::MapPoint*> seen_p(points.begin(), points.end());
-  std::unordered_set<map::MapLine*> seen_l(lines.begin(), lines.end());
+  core::PointerSet seen_p, seen_l;
+  seen_p.clear(points.size());
+  seen_l.clear(lines.size());
+  for (auto* mp : points) seen_p.insert(mp);
+  for (auto* ml : lines) seen_l.insert(ml);
   const std::size_t first_point = points.size(), first_line = lines.size();
   for (auto* k : kfs) {
     for (auto* mp : k->map_points()) {
-      if (mp && !mp->is_bad() && seen_p.insert(mp).second) points.push_back(mp);
+      if (mp && !mp->is_bad() && seen_p.insert(mp)) points.push_back(mp);
     }
     if (with_lines_) {
       for (auto* ml : k->map_lines()) {
-        if (ml && !ml->is_bad() && seen_l.insert(ml).second) lines.push_back(ml);
+        if (ml && !ml->is_bad() && seen_l.insert(ml)) lines.push_back(ml);
       }
     }
   }

@@ -482,15 +482,18 @@ void Tracker::update_local_map(Frame& f) {
   }
   local_points_.clear();
   local_lines_.clear();
-  std::unordered_set<map::MapPoint*> seen_p(f.points.begin(), f.points.end());
-  std::unordered_set<map::MapLine*> seen_l(f.lines.begin(), f.lines.end());
+  // Members, not locals: their arrays are kept from frame to frame.
+  seen_points_.clear(local_points_.capacity() + f.points.size());
+  seen_lines_.clear(local_lines_.capacity() + f.lines.size());
+  for (auto* mp : f.points) seen_points_.insert(mp);
+  for (auto* ml : f.lines) seen_lines_.insert(ml);
   for (auto* kf : local_keyframes_) {
     for (auto* mp : kf->map_points()) {
-      if (mp && !mp->is_bad() && seen_p.insert(mp).second) local_points_.push_back(mp);
+      if (mp && !mp->is_bad() && seen_points_.insert(mp)) local_points_.push_back(mp);
     }
     if (options_.lines) {
       for (auto* ml : kf->map_lines()) {
-        if (ml && !ml->is_bad() && seen_l.insert(ml).second) local_lines_.push_back(ml);
+        if (ml && !ml->is_bad() && seen_lines_.insert(ml)) local_lines_.push_back(ml);
       }
     }
   }

@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "plslam/core/pointer_set.h"
 #include "plslam/geometry/se3.h"
 #include "plslam/map/map.h"
 #include "plslam/optim/pose_only.h"
@@ -254,6 +255,7 @@ class Tracker {
   std::vector<map::KeyFrame*> local_keyframes_;
   std::vector<map::MapPoint*> local_points_;
   std::vector<map::MapLine*> local_lines_;
+  core::PointerSet seen_points_, seen_lines_;  // update_local_map's deduplication
   std::vector<FrameRecord> records_;
   std::optional<std::size_t> last_tracked_record_;  // index into records_
   long seen_big_changes_ = 0;  // map_.big_changes() when the last frame was tracked
