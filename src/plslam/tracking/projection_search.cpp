@@ -3,10 +3,10 @@
 #include <cmath>
 #include <limits>
 #include <optional>
-#include <unordered_set>
 
 #include <opencv2/features2d.hpp>
 
+#include "plslam/core/pointer_set.h"
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/map/descriptor_utils.h"
 #include "plslam/map/keyframe.h"
@@ -110,12 +110,14 @@ int search_points_in_local_map(Frame& cur, const std::vector<map::MapPoint*>& ca
                                const SearchOptions& o) {
   const auto& d = *cur.data;
   const geometry::StereoCamera cam(d.calib);
-  std::unordered_set<const map::MapPoint*> already(cur.points.begin(), cur.points.end());
+  core::PointerSet already;
+  already.clear(cur.points.size());
+  for (const auto* mp : cur.points) already.insert(mp);
   const geometry::SE3 T_wc = cur.T_cw.inverse();
   const Eigen::Vector3d Ow = T_wc.translation();
   int matches = 0;
   for (map::MapPoint* mp : candidates_in) {
-    if (!mp || mp->is_bad() || already.count(mp)) continue;
+    if (!mp || mp->is_bad() || already.contains(mp)) continue;
     const auto v = visibility(*mp, cur.T_cw, Ow, cam);
     if (!v) continue;
     const Eigen::Vector3d& Xc = v->Xc;
@@ -159,13 +161,15 @@ int search_lines(Frame& cur, const std::vector<map::MapLine*>& candidates, doubl
   const auto& d = *cur.data;
   if (d.lines.empty()) return 0;
   const geometry::StereoCamera cam(d.calib);
-  std::unordered_set<const map::MapLine*> already(cur.lines.begin(), cur.lines.end());
+  core::PointerSet already;
+  already.clear(cur.lines.size());
+  for (const auto* ml : cur.lines) already.insert(ml);
   const map::LineMatchGate gate{radius, o.line_max_angle_deg, o.line_min_overlap};
   // Frame lines already matched to a map line with observations are taken.
   const auto taken = [&cur](std::size_t j) { return cur.lines[j] && cur.lines[j]->num_observations() > 0; };
   int matches = 0;
   for (map::MapLine* ml : candidates) {
-    if (!ml || ml->is_bad() || already.count(ml)) continue;
+    if (!ml || ml->is_bad() || already.contains(ml)) continue;
     const auto projected = map::project_line(cam, cur.T_cw, *ml);
     if (!projected) continue;
     const cv::Mat desc = ml->descriptor();
