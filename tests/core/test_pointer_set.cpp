@@ -45,6 +45,17 @@ TEST(PointerSet, AgreesWithUnorderedSetThroughGrowthAndClears) {
   EXPECT_FALSE(set.insert(&objects[1234]));
 }
 
+TEST(PointerSet, AssignKeepsTheNonNullItems) {
+  int a = 0, b = 0;
+  const std::vector<const int*> items = {&a, nullptr, &b, &a};
+  PointerSet set;
+  set.assign(items, 100);
+  EXPECT_EQ(set.size(), 2u);
+  EXPECT_TRUE(set.contains(&a));
+  EXPECT_TRUE(set.contains(&b));
+  EXPECT_FALSE(set.insert(&b));
+}
+
 TEST(PointerSet, ContainsOnAnEmptySetIsFalse) {
   const PointerSet empty;
   int x = 0;

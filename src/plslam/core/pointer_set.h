@@ -7,6 +7,7 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <vector>
 
 namespace plslam::core {
@@ -19,6 +20,13 @@ class PointerSet {
     if (slots_.size() < capacity) slots_.resize(capacity);
     std::fill(slots_.begin(), slots_.end(), nullptr);
     size_ = 0;
+  }
+
+  // Empties the set and inserts `items` (pointers; nulls are skipped), with room for `extra` more.
+  template <typename Range>
+  void assign(const Range& items, std::size_t extra = 0) {
+    clear(std::size(items) + extra);
+    for (const auto* p : items) insert(p);
   }
 
   // True when `p` was not in the set yet. A null pointer is never inserted (returns false).

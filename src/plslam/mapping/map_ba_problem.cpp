@@ -18,10 +18,8 @@ int MapBaProblem::add_keyframe(map::KeyFrame* kf, bool fixed) {
 
 void MapBaProblem::add_landmarks_of(const std::vector<map::KeyFrame*>& kfs) {
   core::PointerSet seen_p, seen_l;
-  seen_p.clear(points.size());
-  seen_l.clear(lines.size());
-  for (auto* mp : points) seen_p.insert(mp);
-  for (auto* ml : lines) seen_l.insert(ml);
+  seen_p.assign(points);
+  seen_l.assign(lines);
   const std::size_t first_point = points.size(), first_line = lines.size();
   for (auto* k : kfs) {
     for (auto* mp : k->map_points()) {

@@ -111,8 +111,7 @@ int search_points_in_local_map(Frame& cur, const std::vector<map::MapPoint*>& ca
   const auto& d = *cur.data;
   const geometry::StereoCamera cam(d.calib);
   core::PointerSet already;
-  already.clear(cur.points.size());
-  for (const auto* mp : cur.points) already.insert(mp);
+  already.assign(cur.points);
   const geometry::SE3 T_wc = cur.T_cw.inverse();
   const Eigen::Vector3d Ow = T_wc.translation();
   int matches = 0;
@@ -162,8 +161,7 @@ int search_lines(Frame& cur, const std::vector<map::MapLine*>& candidates, doubl
   if (d.lines.empty()) return 0;
   const geometry::StereoCamera cam(d.calib);
   core::PointerSet already;
-  already.clear(cur.lines.size());
-  for (const auto* ml : cur.lines) already.insert(ml);
+  already.assign(cur.lines);
   const map::LineMatchGate gate{radius, o.line_max_angle_deg, o.line_min_overlap};
   // Frame lines already matched to a map line with observations are taken.
   const auto taken = [&cur](std::size_t j) { return cur.lines[j] && cur.lines[j]->num_observations() > 0; };

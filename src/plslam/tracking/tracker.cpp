@@ -483,10 +483,8 @@ void Tracker::update_local_map(Frame& f) {
   local_points_.clear();
   local_lines_.clear();
   // Members, not locals: their arrays are kept from frame to frame.
-  seen_points_.clear(local_points_.capacity() + f.points.size());
-  seen_lines_.clear(local_lines_.capacity() + f.lines.size());
-  for (auto* mp : f.points) seen_points_.insert(mp);
-  for (auto* ml : f.lines) seen_lines_.insert(ml);
+  seen_points_.assign(f.points, local_points_.capacity());
+  seen_lines_.assign(f.lines, local_lines_.capacity());
   for (auto* kf : local_keyframes_) {
     for (auto* mp : kf->map_points()) {
       if (mp && !mp->is_bad() && seen_points_.insert(mp)) local_points_.push_back(mp);
