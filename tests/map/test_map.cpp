@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cstring>
 #include <set>
 
 #include "plslam/map/descriptor_utils.h"
@@ -269,6 +272,52 @@ TEST(Map, MostDistinctiveDescriptorHasSmallestMedianDistance) {
   // Median distances (self included, as ORB-SLAM2): central 4, the others 8, the far one 60+.
   EXPECT_EQ(descriptor_distance(most_distinctive(d), d[1]), 0);
   EXPECT_TRUE(most_distinctive({}).empty());
+}
+
+TEST(Map, MostDistinctiveIndexIsTheFirstRowWithTheSmallestMedian) {
+  // Against the definition, on random rows and on rows with ties (few distinct values).
+  cv::RNG rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = 1 + trial % 23;
+    cv::Mat rows(n, 32, CV_8U);
+    rng.fill(rows, cv::RNG::UNIFORM, 0, trial % 2 ? 256 : 2);
+    std::vector<const uint8_t*> ptrs;
+    std::vector<cv::Mat> mats;
+    for (int i = 0; i < n; ++i) {
+      ptrs.push_back(rows.ptr<uint8_t>(i));
+      mats.push_back(rows.row(i));
+    }
+    std::size_t expected = 0;
+    int best = 1 << 30;
+    for (int i = 0; i < n; ++i) {
+      std::vector<int> dist;
+      for (int j = 0; j < n; ++j) dist.push_back(descriptor_distance(rows.row(i), rows.row(j)));
+      std::sort(dist.begin(), dist.end());
+      if (dist[static_cast<std::size_t>((n - 1) / 2)] < best) {
+        best = dist[static_cast<std::size_t>((n - 1) / 2)];
+        expected = static_cast<std::size_t>(i);
+      }
+    }
+    ASSERT_EQ(most_distinctive_index(ptrs), expected) << "trial " << trial;
+    ASSERT_EQ(descriptor_distance(most_distinctive(mats), rows.row(static_cast<int>(expected))), 0);
+  }
+  EXPECT_EQ(most_distinctive_index({}), 0u);
+}
+
+TEST(Map, CopiedDescriptorIsTheLandmarksDescriptor) {
+  Fixture f;
+  MapPoint* p = f.k[0]->map_point(0);
+  ASSERT_NE(p, nullptr);
+  std::array<uint8_t, 32> bytes{};
+  bytes.fill(7);
+  MapPoint* fresh = f.map.create_point({0, 0, 1}, f.k[0], 0);
+  EXPECT_FALSE(fresh->copy_descriptor(bytes));  // no observation, no descriptor: untouched
+  EXPECT_EQ(bytes[0], 7);
+  p->update_descriptor();
+  ASSERT_TRUE(p->copy_descriptor(bytes));
+  const cv::Mat d = p->descriptor();
+  ASSERT_EQ(d.total(), 32u);
+  EXPECT_EQ(0, std::memcmp(bytes.data(), d.ptr<uint8_t>(0), 32));
 }
 
 TEST(FrameData, GridSearchFindsExactlyThePointsInTheRadius) {

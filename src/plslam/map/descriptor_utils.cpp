@@ -11,25 +11,37 @@ int descriptor_distance(const cv::Mat& a, const cv::Mat& b) {
   return features::hamming_distance(a.ptr<uint8_t>(0), b.ptr<uint8_t>(0));
 }
 
-cv::Mat most_distinctive(const std::vector<cv::Mat>& descriptors) {
-  const std::size_t n = descriptors.size();
-  if (n == 0) return {};
-  std::vector<std::vector<int>> d(n, std::vector<int>(n, 0));
+std::size_t most_distinctive_index(const std::vector<const uint8_t*>& rows) {
+  const std::size_t n = rows.size();
+  if (n < 3) return 0;  // with one or two rows, the first has the smallest median (ties: the first)
+  // One flat matrix and one scratch row: this runs for every landmark a keyframe touches, and
+  // the allocations of a matrix of rows were as costly as the distances.
+  std::vector<int> d(n * n, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = i + 1; j < n; ++j) d[i][j] = d[j][i] = descriptor_distance(descriptors[i], descriptors[j]);
+    for (std::size_t j = i + 1; j < n; ++j) d[i * n + j] = d[j * n + i] = features::hamming_distance(rows[i], rows[j]);
   }
+  const auto mid = static_cast<std::ptrdiff_t>((n - 1) / 2);
+  std::vector<int> row(n);
   int best = std::numeric_limits<int>::max();
   std::size_t best_i = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    auto row = d[i];
-    std::nth_element(row.begin(), row.begin() + static_cast<std::ptrdiff_t>((n - 1) / 2), row.end());
-    const int median = row[(n - 1) / 2];
-    if (median < best) {
-      best = median;
+    std::copy(d.begin() + static_cast<std::ptrdiff_t>(i * n), d.begin() + static_cast<std::ptrdiff_t>((i + 1) * n),
+              row.begin());
+    std::nth_element(row.begin(), row.begin() + mid, row.end());
+    if (row[static_cast<std::size_t>(mid)] < best) {
+      best = row[static_cast<std::size_t>(mid)];
       best_i = i;
     }
   }
-  return descriptors[best_i].clone();
+  return best_i;
+}
+
+cv::Mat most_distinctive(const std::vector<cv::Mat>& descriptors) {
+  if (descriptors.empty()) return {};
+  std::vector<const uint8_t*> rows;
+  rows.reserve(descriptors.size());
+  for (const auto& m : descriptors) rows.push_back(m.ptr<uint8_t>(0));
+  return descriptors[most_distinctive_index(rows)].clone();
 }
 
 }  // namespace plslam::map

@@ -1,5 +1,7 @@
 #pragma once
 // Descriptor helpers shared by points and lines (both 256-bit binary descriptors).
+#include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -12,5 +14,7 @@ int descriptor_distance(const cv::Mat& a, const cv::Mat& b);
 // The descriptor with the smallest median distance to all others (ORB-SLAM2's choice of a
 // landmark's representative descriptor). Empty input gives an empty Mat.
 cv::Mat most_distinctive(const std::vector<cv::Mat>& descriptors);
+// The same choice on 32-byte rows: the index of the chosen row (0 for an empty input).
+std::size_t most_distinctive_index(const std::vector<const uint8_t*>& rows);
 
 }  // namespace plslam::map

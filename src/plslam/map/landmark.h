@@ -9,7 +9,9 @@
 // Owned by the Map; the state is guarded by the landmark's own mutex because tracking reads it
 // while local mapping writes it. Member definitions: landmark_impl.h, instantiated by the derived
 // classes' .cpp files.
+#include <array>
 #include <atomic>
+#include <cstdint>
 #include <mutex>
 #include <utility>
 #include <vector>
@@ -70,6 +72,9 @@ class Landmark {
   // The most distinctive descriptor among the observations (smallest median Hamming distance).
   void update_descriptor();
   cv::Mat descriptor() const;  // the caller's own copy
+  // The same 32 bytes without a heap copy, for the matching loops that read one per landmark;
+  // false (and `out` untouched) while the landmark has no descriptor.
+  bool copy_descriptor(std::array<uint8_t, 32>& out) const;
   Eigen::Vector3d normal() const;
   double min_distance() const;
   double max_distance() const;

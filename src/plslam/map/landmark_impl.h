@@ -1,6 +1,7 @@
 #pragma once
 // Definitions of Landmark<Derived>; included by map_point.cpp and map_line.cpp only.
 #include <algorithm>
+#include <stdexcept>
 #include <vector>
 
 #include "plslam/map/descriptor_utils.h"
@@ -83,12 +84,22 @@ KeyFrame* Landmark<D>::reference() const {
 
 template <class D>
 void Landmark<D>::update_descriptor() {
-  std::vector<cv::Mat> descs;
-  for (const auto& [kf, idx] : observation_list()) {
-    if (!kf->is_bad()) descs.push_back(D::descriptor_row(*kf, idx));
+  // Rows are read in place: the keyframes' descriptor matrices outlive this call (keyframes are
+  // never freed), and only the chosen row is copied.
+  const auto observations = observation_list();
+  std::vector<const uint8_t*> rows;
+  std::vector<std::size_t> which;
+  rows.reserve(observations.size());
+  which.reserve(observations.size());
+  for (std::size_t k = 0; k < observations.size(); ++k) {
+    const auto& [kf, idx] = observations[k];
+    if (kf->is_bad()) continue;
+    rows.push_back(D::descriptor_row(*kf, idx).template ptr<uint8_t>(0));
+    which.push_back(k);
   }
-  cv::Mat best = most_distinctive(descs);
-  if (best.empty()) return;
+  if (rows.empty()) return;
+  const auto& [kf, idx] = observations[which[most_distinctive_index(rows)]];
+  cv::Mat best = D::descriptor_row(*kf, idx).clone();
   std::lock_guard lock(mutex_);
   descriptor_ = best;
 }
@@ -99,6 +110,17 @@ cv::Mat Landmark<D>::descriptor() const {
   // A deep copy: a cv::Mat copy would share the buffer (and its reference count) with the
   // mapping thread, which replaces the descriptor while tracking reads it.
   return descriptor_.clone();
+}
+
+template <class D>
+bool Landmark<D>::copy_descriptor(std::array<uint8_t, 32>& out) const {
+  std::lock_guard lock(mutex_);
+  if (descriptor_.empty()) return false;
+  if (!descriptor_.isContinuous() || descriptor_.total() * descriptor_.elemSize() != out.size()) {
+    throw std::logic_error("a landmark descriptor is not 32 contiguous bytes");
+  }
+  std::copy_n(descriptor_.ptr<uint8_t>(0), out.size(), out.begin());
+  return true;
 }
 
 template <class D>

@@ -1,9 +1,11 @@
 #include "plslam/mapping/keyframe_projection.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
+#include "plslam/features/orb_descriptor.h"
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/map/descriptor_utils.h"
 #include "plslam/map/line_projection.h"
@@ -23,14 +25,14 @@ int match_point_in_keyframe(const map::KeyFrame& kf, const geometry::SE3& T_cw, 
   if (dist < mp.min_distance() || dist > mp.max_distance()) return -1;
   const int level = mp.predict_level(dist, d.levels, d.scale_factor);
   const double r = o.point_radius * d.level_scale(level);
-  const cv::Mat desc = mp.descriptor();
-  if (desc.empty()) return -1;
+  std::array<uint8_t, 32> desc;
+  if (!mp.copy_descriptor(desc)) return -1;
   int best = o.point_max_hamming, best_j = -1;
   for (int j : d.points_in_area(uv.x(), uv.y(), r, std::max(0, level - 1), level + 1)) {
     const auto& kp = d.keypoints[static_cast<std::size_t>(j)];
     const double e2 = (uv - Eigen::Vector2d(kp.pt.x, kp.pt.y)).squaredNorm();
     if (e2 > o.point_chi2 * d.level_sigma2(kp.octave)) continue;
-    const int h = map::descriptor_distance(desc, d.descriptors.row(j));
+    const int h = features::hamming_distance(desc.data(), d.descriptors.ptr<uint8_t>(j));
     if (h < best) {
       best = h;
       best_j = j;

@@ -1,5 +1,6 @@
 #include "plslam/tracking/projection_search.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -7,6 +8,7 @@
 #include <opencv2/features2d.hpp>
 
 #include "plslam/core/pointer_set.h"
+#include "plslam/features/orb_descriptor.h"
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/map/descriptor_utils.h"
 #include "plslam/map/keyframe.h"
@@ -79,13 +81,13 @@ int search_points_from_frame(Frame& cur, const Frame& last, double radius, const
     const double r = radius * d.level_scale(level);
     const auto candidates = d.points_in_area(uv.x(), uv.y(), r, std::max(0, level - 1), level + 1);
     if (candidates.empty()) continue;
-    const cv::Mat desc = mp->descriptor();
-    if (desc.empty()) continue;
+    std::array<uint8_t, 32> desc;
+    if (!mp->copy_descriptor(desc)) continue;
     const double u_right = uv.x() - cam.bf() / Xc.z();
     int best = std::numeric_limits<int>::max(), second = best, best_j = -1;
     for (int j : candidates) {
       if (slot_taken(cur, j) || !stereo_consistent(d, j, u_right, r)) continue;
-      const int dist = map::descriptor_distance(desc, d.descriptors.row(j));
+      const int dist = features::hamming_distance(desc.data(), d.descriptors.ptr<uint8_t>(j));
       if (dist < best) {
         second = best;
         best = dist;
@@ -127,13 +129,13 @@ int search_points_in_local_map(Frame& cur, const std::vector<map::MapPoint*>& ca
     const double r = radius * (view_cos > 0.998 ? 2.5 : 4.0) * d.level_scale(level);
     const auto candidates = d.points_in_area(uv.x(), uv.y(), r, std::max(0, level - 1), level);
     if (candidates.empty()) continue;
-    const cv::Mat desc = mp->descriptor();
-    if (desc.empty()) continue;
+    std::array<uint8_t, 32> desc;
+    if (!mp->copy_descriptor(desc)) continue;
     const double u_right = uv.x() - cam.bf() / Xc.z();
     int best = std::numeric_limits<int>::max(), second = best, best_j = -1, best_level = -1, second_level = -1;
     for (int j : candidates) {
       if (slot_taken(cur, j) || !stereo_consistent(d, j, u_right, r)) continue;
-      const int dist_h = map::descriptor_distance(desc, d.descriptors.row(j));
+      const int dist_h = features::hamming_distance(desc.data(), d.descriptors.ptr<uint8_t>(j));
       const int lvl = d.keypoints[static_cast<std::size_t>(j)].octave;
       if (dist_h < best) {
         second = best;
