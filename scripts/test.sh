@@ -7,7 +7,7 @@
 #   scripts/test.sh --sanitize thread --tests R  ... only the tests whose name matches regex R
 #
 # Other arguments go to CMake (e.g. -DPLSLAM_SHARED_DIR=...). BUILD_DIR overrides the build folder.
-# A sanitizer build is -O1 -g with frame pointers (cmake/Sanitizers.cmake) and every test process
+# A sanitizer build is -O1 -g1 with frame pointers (cmake/Sanitizers.cmake) and every test process
 # stops at its first report (halt_on_error), so any report fails the run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
