@@ -67,9 +67,12 @@ TEST(RunVideo, ASyntheticVideoTracksLikeItsImageFolders) {
 }
 
 // The live path end to end, without a camera: a video file given to --camera is played at its
-// frame rate (100 Hz here, faster than tracking), so the capture drops the frames tracking has no
-// time for, counts them, and the run still tracks what it takes.
-TEST(RunVideo, AVideoPlayedAsACameraDropsWhatTrackingHasNoTimeFor) {
+// frame rate (100 Hz here, about as fast as tracking), so the capture drops the frames tracking
+// has no time for, counts them, and the run still tracks what it takes. How many are dropped is a
+// race between decoding and tracking on the machine (1-14 of 60 so far, and once none under CI's
+// load), so only the accounting is asserted here; LiveCapture.ASlowConsumerGetsTheNewestFrameAnd
+// DropsAreCounted drops frames for certain with a slow consumer.
+TEST(RunVideo, AVideoPlayedAsACameraAccountsForEveryFrameTakenOrDropped) {
   test::TempDir tmp;
   constexpr int kFrames = 60;
   const auto video = tmp.path() / "video";
@@ -80,7 +83,6 @@ TEST(RunVideo, AVideoPlayedAsACameraDropsWhatTrackingHasNoTimeFor) {
   r = test::run_cli("run --camera " + q(video / "stereo.mkv") + " --calib " + q(video / "calibration.yaml") +
                     " --out " + q(out));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.err.find("dropped (tracking was busy"), std::string::npos) << r.err;
   const auto stats = read_json(out / "stats.json");
   const auto& live = stats["live"];
   ASSERT_TRUE(live.is_object()) << stats;
@@ -89,10 +91,14 @@ TEST(RunVideo, AVideoPlayedAsACameraDropsWhatTrackingHasNoTimeFor) {
   EXPECT_EQ(stats["input_frames"], kFrames);
   EXPECT_EQ(stats["complete"], true);
   EXPECT_EQ(stats["interrupted_by"], nullptr);
-  // Every frame was taken or dropped (the last one is always taken), and tracking had no time for
-  // most of them at 100 Hz.
-  EXPECT_EQ(live["taken"].get<int>() + live["dropped"].get<int>(), kFrames);
-  EXPECT_GT(live["dropped"].get<int>(), 0);
+  // Every frame was taken or dropped (the last one is always taken), and the log says how many.
+  const int taken = live["taken"].get<int>(), dropped = live["dropped"].get<int>();
+  EXPECT_EQ(taken + dropped, kFrames);
+  EXPECT_GT(taken, 0);
+  EXPECT_NE(r.err.find(std::to_string(kFrames) + " frames captured, " + std::to_string(taken) + " taken by tracking, " +
+                       std::to_string(dropped) + " dropped (tracking was busy"),
+            std::string::npos)
+      << r.err;
   EXPECT_EQ(stats["frames"], live["taken"]);
   EXPECT_EQ(stats["tracked_frames"], live["taken"]);
   EXPECT_FALSE(fs::exists(out / "trajectory.kitti"));
