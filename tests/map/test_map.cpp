@@ -270,8 +270,10 @@ TEST(Map, MostDistinctiveDescriptorHasSmallestMedianDistance) {
   const std::vector<cv::Mat> d{with_bits(0, 4), with_bits(0, 0), with_bits(4, 8), with_bits(8, 12),
                                with_bits(100, 160)};
   // Median distances (self included, as ORB-SLAM2): central 4, the others 8, the far one 60+.
-  EXPECT_EQ(descriptor_distance(most_distinctive(d), d[1]), 0);
-  EXPECT_TRUE(most_distinctive({}).empty());
+  std::vector<const uint8_t*> rows;
+  for (const auto& m : d) rows.push_back(m.ptr<uint8_t>(0));
+  EXPECT_EQ(descriptor_distance(d[most_distinctive_index(rows)], d[1]), 0);
+  EXPECT_EQ(most_distinctive_index({}), 0u);
 }
 
 TEST(Map, MostDistinctiveIndexIsTheFirstRowWithTheSmallestMedian) {
@@ -282,11 +284,7 @@ TEST(Map, MostDistinctiveIndexIsTheFirstRowWithTheSmallestMedian) {
     cv::Mat rows(n, 32, CV_8U);
     rng.fill(rows, cv::RNG::UNIFORM, 0, trial % 2 ? 256 : 2);
     std::vector<const uint8_t*> ptrs;
-    std::vector<cv::Mat> mats;
-    for (int i = 0; i < n; ++i) {
-      ptrs.push_back(rows.ptr<uint8_t>(i));
-      mats.push_back(rows.row(i));
-    }
+    for (int i = 0; i < n; ++i) ptrs.push_back(rows.ptr<uint8_t>(i));
     std::size_t expected = 0;
     int best = 1 << 30;
     for (int i = 0; i < n; ++i) {
@@ -299,9 +297,7 @@ TEST(Map, MostDistinctiveIndexIsTheFirstRowWithTheSmallestMedian) {
       }
     }
     ASSERT_EQ(most_distinctive_index(ptrs), expected) << "trial " << trial;
-    ASSERT_EQ(descriptor_distance(most_distinctive(mats), rows.row(static_cast<int>(expected))), 0);
   }
-  EXPECT_EQ(most_distinctive_index({}), 0u);
 }
 
 TEST(Map, CopiedDescriptorIsTheLandmarksDescriptor) {

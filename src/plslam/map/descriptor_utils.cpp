@@ -36,12 +36,4 @@ std::size_t most_distinctive_index(const std::vector<const uint8_t*>& rows) {
   return best_i;
 }
 
-cv::Mat most_distinctive(const std::vector<cv::Mat>& descriptors) {
-  if (descriptors.empty()) return {};
-  std::vector<const uint8_t*> rows;
-  rows.reserve(descriptors.size());
-  for (const auto& m : descriptors) rows.push_back(m.ptr<uint8_t>(0));
-  return descriptors[most_distinctive_index(rows)].clone();
-}
-
 }  // namespace plslam::map

@@ -11,10 +11,9 @@ namespace plslam::map {
 // Hamming distance of two 1x32 CV_8U rows (ORB and LBD descriptors are both 256 bits).
 int descriptor_distance(const cv::Mat& a, const cv::Mat& b);
 
-// The descriptor with the smallest median distance to all others (ORB-SLAM2's choice of a
-// landmark's representative descriptor). Empty input gives an empty Mat.
-cv::Mat most_distinctive(const std::vector<cv::Mat>& descriptors);
-// The same choice on 32-byte rows: the index of the chosen row (0 for an empty input).
+// Of 32-byte descriptor rows, the index of the first with the smallest median distance to all
+// rows, itself included (ORB-SLAM2's choice of a landmark's representative descriptor); 0 for an
+// empty input.
 std::size_t most_distinctive_index(const std::vector<const uint8_t*>& rows);
 
 }  // namespace plslam::map

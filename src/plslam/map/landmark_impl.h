@@ -86,19 +86,13 @@ template <class D>
 void Landmark<D>::update_descriptor() {
   // Rows are read in place: the keyframes' descriptor matrices outlive this call (keyframes are
   // never freed), and only the chosen row is copied.
-  const auto observations = observation_list();
+  auto observations = observation_list();
+  std::erase_if(observations, [](const auto& o) { return o.first->is_bad(); });
+  if (observations.empty()) return;
   std::vector<const uint8_t*> rows;
-  std::vector<std::size_t> which;
   rows.reserve(observations.size());
-  which.reserve(observations.size());
-  for (std::size_t k = 0; k < observations.size(); ++k) {
-    const auto& [kf, idx] = observations[k];
-    if (kf->is_bad()) continue;
-    rows.push_back(D::descriptor_row(*kf, idx).template ptr<uint8_t>(0));
-    which.push_back(k);
-  }
-  if (rows.empty()) return;
-  const auto& [kf, idx] = observations[which[most_distinctive_index(rows)]];
+  for (const auto& [kf, idx] : observations) rows.push_back(D::descriptor_row(*kf, idx).template ptr<uint8_t>(0));
+  const auto& [kf, idx] = observations[most_distinctive_index(rows)];
   cv::Mat best = D::descriptor_row(*kf, idx).clone();
   std::lock_guard lock(mutex_);
   descriptor_ = best;

@@ -7,7 +7,6 @@
 
 #include "plslam/features/orb_descriptor.h"
 #include "plslam/geometry/stereo_camera.h"
-#include "plslam/map/descriptor_utils.h"
 #include "plslam/map/line_projection.h"
 
 namespace plslam::mapping {

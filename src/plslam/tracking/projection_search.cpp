@@ -10,7 +10,6 @@
 #include "plslam/core/pointer_set.h"
 #include "plslam/features/orb_descriptor.h"
 #include "plslam/geometry/stereo_camera.h"
-#include "plslam/map/descriptor_utils.h"
 #include "plslam/map/keyframe.h"
 #include "plslam/map/line_projection.h"
 #include "plslam/map/map_line.h"
