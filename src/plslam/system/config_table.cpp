@@ -117,6 +117,8 @@ std::vector<ConfigKey> make_table() {
           "scale between pyramid levels"),
     field("features", "fast_threshold", [](auto& o) -> auto& { return o.extractor.orb.fast_threshold; },
           "FAST corner threshold"),
+    field("features", "right_points_factor", [](auto& o) -> auto& { return o.extractor.right_points_factor; },
+          "the right image keeps this many times n_points (more candidates for stereo matches)", in_closed(0.1, 10)),
     distribution_key(),
 
     lines_enabled_key(),
