@@ -19,17 +19,25 @@ LineFeatures extract_lines(const cv::Mat& grey, const LineExtractorOptions& o, L
   t0 = std::chrono::steady_clock::now();
   LineFeatures f;
   f.image_size = grey.size();
-  f.lines = o.merge_enabled ? merge_segments(std::move(det.segments), grey.size(), o.merge) : std::move(det.segments);
-  t.merged = f.lines.size();
-  if (o.min_angle_from_horizontal_deg > 0) {
-    // For stereo use: a line within this angle of the rows has an ill-conditioned disparity, so
-    // it would only take one of the N places from a line that can be matched.
-    const double s_min = std::sin(o.min_angle_from_horizontal_deg * M_PI / 180.0);
-    std::erase_if(f.lines, [&](const LineSegment& l) {
+  // For stereo use: a line within min_angle_from_horizontal_deg of the rows has an ill-conditioned
+  // disparity, so it would only take one of the N places from a line that can be matched.
+  const auto drop_flatter_than = [](std::vector<LineSegment>& lines, double deg) {
+    const double s_min = std::sin(deg * M_PI / 180.0);
+    std::erase_if(lines, [&](const LineSegment& l) {
       const double len = l.length();
       return len <= 0 || std::abs(l.end.y - l.start.y) < s_min * len;
     });
+  };
+  if (o.merge_enabled && o.min_angle_from_horizontal_deg > 0) {
+    // Most segments of a street are flat (about 350 of 620 per image on the rendered street
+    // loop), and merging them took 1.2-1.5 ms of the 5.2 per image (0.36 ms without them). Pieces
+    // merge only within max_theta_deg of each other, so a piece flatter than the limit by twice
+    // that could reach a kept line only through a chain of merges that each turn it further.
+    drop_flatter_than(det.segments, o.min_angle_from_horizontal_deg - 2 * o.merge.max_theta_deg);
   }
+  f.lines = o.merge_enabled ? merge_segments(std::move(det.segments), grey.size(), o.merge) : std::move(det.segments);
+  t.merged = f.lines.size();
+  if (o.min_angle_from_horizontal_deg > 0) drop_flatter_than(f.lines, o.min_angle_from_horizontal_deg);
   keep_best(f.lines, o.max_lines);
   t.kept = f.lines.size();
   t.merge_ms = ms_since(t0);
