@@ -2,6 +2,7 @@
 // prototype descriptors, and a keyframe of a place holds noisy copies of them. A query must find
 // its own place first, never a culled or excluded keyframe, and group covisible keyframes; adds,
 // erases and queries from several threads must be safe (this suite runs under ThreadSanitizer).
+#include <algorithm>
 #include <atomic>
 #include <memory>
 #include <random>
@@ -112,6 +113,22 @@ TEST(KeyframeDatabase, ErasedBadAndExcludedKeyframesAreNeverReturned) {
   o.exclude = [&](const map::KeyFrame* kf) { return kf == kfs[0]; };
   EXPECT_FALSE(returned(kfs[0], o));
   EXPECT_TRUE(returned(kfs[0]));
+  // A keyframe added after an erase takes the freed slot: it is found under its own words, with
+  // its own count of common words, and the erased one stays gone.
+  map::KeyFrame* later = m.create_keyframe(places().frame(9, 2), geometry::SE3());
+  db.add(later);
+  const auto q2 = db.describe(to_mat(places().view(2))).bow;
+  const auto c2 = db.query(q2);
+  ASSERT_FALSE(c2.empty());
+  EXPECT_EQ(c2.front().keyframe, later);
+  const auto& later_bow = db.description(later)->bow;
+  int common = 0;
+  for (const auto& [word, weight] : q2) {
+    common += std::any_of(later_bow.begin(), later_bow.end(), [&, w = word](const auto& e) { return e.first == w; });
+  }
+  EXPECT_EQ(c2.front().common_words, common);
+  for (const auto& c : c2) EXPECT_NE(c.keyframe, kfs[1]);
+  EXPECT_FALSE(returned(kfs[1]));
   // No word in common: nothing.
   EXPECT_TRUE(db.query({}).empty());
   EXPECT_TRUE(db.describe(cv::Mat()).bow.empty());

@@ -26,33 +26,43 @@ void KeyframeDatabase::add(map::KeyFrame* kf) {
 
 void KeyframeDatabase::add(map::KeyFrame* kf, std::shared_ptr<const PlaceDescription> d) {
   std::lock_guard lock(mutex_);
-  if (auto it = entries_.find(kf); it != entries_.end()) {
-    unindex_locked(kf, *it->second);
-    entries_.erase(it);
+  erase_locked(kf);
+  int slot;
+  if (free_slots_.empty()) {
+    slot = static_cast<int>(slots_.size());
+    slots_.emplace_back();
+  } else {
+    slot = free_slots_.back();
+    free_slots_.pop_back();
   }
-  for (const auto& [word, weight] : d->bow) inverted_[word].push_back(kf);
-  entries_.emplace(kf, std::move(d));
+  for (const auto& [word, weight] : d->bow) inverted_[word].push_back(slot);
+  slots_[static_cast<std::size_t>(slot)] = {kf, std::move(d)};
+  entries_.emplace(kf, slot);
 }
 
-void KeyframeDatabase::unindex_locked(const map::KeyFrame* kf, const PlaceDescription& d) {
-  for (const auto& [word, weight] : d.bow) {
+void KeyframeDatabase::erase_locked(const map::KeyFrame* kf) {
+  auto it = entries_.find(kf);
+  if (it == entries_.end()) return;
+  const int slot = it->second;
+  Slot& s = slots_[static_cast<std::size_t>(slot)];
+  for (const auto& [word, weight] : s.description->bow) {
     auto& list = inverted_[word];
-    list.erase(std::remove(list.begin(), list.end(), kf), list.end());
+    list.erase(std::remove(list.begin(), list.end(), slot), list.end());
   }
+  s = {};
+  free_slots_.push_back(slot);
+  entries_.erase(it);
 }
 
 void KeyframeDatabase::erase(const map::KeyFrame* kf) {
   std::lock_guard lock(mutex_);
-  auto it = entries_.find(kf);
-  if (it == entries_.end()) return;
-  unindex_locked(kf, *it->second);
-  entries_.erase(it);
+  erase_locked(kf);
 }
 
 std::shared_ptr<const PlaceDescription> KeyframeDatabase::description(const map::KeyFrame* kf) const {
   std::lock_guard lock(mutex_);
   auto it = entries_.find(kf);
-  return it == entries_.end() ? nullptr : it->second;
+  return it == entries_.end() ? nullptr : slots_[static_cast<std::size_t>(it->second)].description;
 }
 
 std::size_t KeyframeDatabase::size() const {
@@ -61,46 +71,64 @@ std::size_t KeyframeDatabase::size() const {
 }
 
 std::vector<PlaceCandidate> KeyframeDatabase::query(const BowVector& bow, const DatabaseQueryOptions& o) const {
-  // 1. Keyframes sharing words, with how many (ordered by id, so ties break the same every run).
-  map::IdMap<map::KeyFrame, int> common;
-  map::IdMap<map::KeyFrame, double> scores;
+  // Keyframe, common words and score, ordered by keyframe id (ties break the same every run).
+  struct Scored {
+    map::KeyFrame* keyframe;
+    int common;
+    double score;
+    int slot;
+  };
+  std::vector<Scored> scores;
+  const auto by_id = [](const Scored& a, const Scored& b) { return a.keyframe->id() < b.keyframe->id(); };
   {
     std::lock_guard lock(mutex_);
+    // 1. Keyframes sharing words, with how many.
+    std::vector<int> common(slots_.size(), 0);
+    std::vector<int> touched;
     for (const auto& [word, weight] : bow) {
       if (word >= inverted_.size()) continue;
-      for (map::KeyFrame* kf : inverted_[word]) ++common[kf];
-    }
-    int max_common = 0;
-    for (auto it = common.begin(); it != common.end();) {
-      if (it->first->is_bad() || (o.exclude && o.exclude(it->first))) {
-        it = common.erase(it);
-      } else {
-        max_common = std::max(max_common, it->second);
-        ++it;
+      for (const int slot : inverted_[word]) {
+        if (common[static_cast<std::size_t>(slot)]++ == 0) touched.push_back(slot);
       }
     }
+    std::vector<Scored> shared;
+    shared.reserve(touched.size());
+    int max_common = 0;
+    for (const int slot : touched) {
+      map::KeyFrame* kf = slots_[static_cast<std::size_t>(slot)].keyframe;
+      if (kf->is_bad() || (o.exclude && o.exclude(kf))) continue;
+      const int n = common[static_cast<std::size_t>(slot)];
+      max_common = std::max(max_common, n);
+      shared.push_back({kf, n, 0.0, slot});
+    }
+    std::sort(shared.begin(), shared.end(), by_id);
     // 2. Score those sharing enough words.
     const double min_common = o.min_common_share * max_common;
-    for (const auto& [kf, n] : common) {
-      if (n < min_common) continue;
-      const double s = l1_score(bow, entries_.at(kf)->bow);
-      if (s >= o.min_score) scores.emplace(kf, s);
+    for (Scored& c : shared) {
+      if (c.common < min_common) continue;
+      c.score = l1_score(bow, slots_[static_cast<std::size_t>(c.slot)].description->bow);
+      if (c.score >= o.min_score) scores.push_back(c);
     }
   }
+  const auto scored = [&](const map::KeyFrame* kf) -> const Scored* {
+    const auto it = std::lower_bound(scores.begin(), scores.end(), kf->id(),
+                                     [](const Scored& a, long id) { return a.keyframe->id() < id; });
+    return it != scores.end() && it->keyframe == kf ? &*it : nullptr;
+  };
   // 3. Sum each scored keyframe's score with its covisible neighbours' (outside the database lock:
   //    the covisibility graph has its own).
   std::vector<PlaceCandidate> groups;
   double best_group = 0;
-  for (const auto& [kf, s] : scores) {
-    PlaceCandidate c{kf, s, s, common.at(kf)};
-    for (map::KeyFrame* n : kf->best_covisibles(o.group_size)) {
-      auto it = scores.find(n);
-      if (it == scores.end()) continue;
-      c.group_score += it->second;
-      if (it->second > c.score) {
-        c.score = it->second;
+  for (const Scored& k : scores) {
+    PlaceCandidate c{k.keyframe, k.score, k.score, k.common};
+    for (map::KeyFrame* n : k.keyframe->best_covisibles(o.group_size)) {
+      const Scored* other = scored(n);
+      if (!other) continue;
+      c.group_score += other->score;
+      if (other->score > c.score) {
+        c.score = other->score;
         c.keyframe = n;
-        c.common_words = common.at(n);
+        c.common_words = other->common;
       }
     }
     best_group = std::max(best_group, c.group_score);

@@ -79,10 +79,19 @@ class KeyframeDatabase {
   std::shared_ptr<const Vocabulary> vocabulary_;
   int feature_levels_up_;
   mutable std::mutex mutex_;
-  std::vector<std::vector<map::KeyFrame*>> inverted_;  // word -> keyframes, in insertion order
-  map::IdMap<const map::KeyFrame, std::shared_ptr<const PlaceDescription>> entries_;
+  // Each indexed keyframe has a slot; the inverted file lists slots, so that a query counts
+  // common words in a plain array (with an ordered map per query this was 1.4 % of a street
+  // run's CPU). Freed slots are reused.
+  struct Slot {
+    map::KeyFrame* keyframe = nullptr;  // null: free
+    std::shared_ptr<const PlaceDescription> description;
+  };
+  std::vector<std::vector<int>> inverted_;  // word -> slots, in insertion order
+  std::vector<Slot> slots_;
+  std::vector<int> free_slots_;
+  map::IdMap<const map::KeyFrame, int> entries_;  // keyframe -> slot
 
-  void unindex_locked(const map::KeyFrame* kf, const PlaceDescription& d);
+  void erase_locked(const map::KeyFrame* kf);
 };
 
 }  // namespace plslam::place
