@@ -14,6 +14,7 @@
 # Timings are only comparable within one sitting: run nothing else meanwhile.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. bench/lib/preset_key.sh
 runs=3 key="" values="" sequences="kitti06 kitti01 street office corridor"
 while [ $# -gt 1 ]; do
   case "$1" in
@@ -37,13 +38,7 @@ summary="$out/summary.txt"
 
 for preset in kitti euroc; do
   for v in $values; do
-    file="$out/configs/$preset-$v.yaml"
-    awk -v section="$section:" -v key="$name" -v value="$v" '
-      $0 == section { in_section = 1; print; print "  " key ": " value; next }
-      /^[^ #]/ { in_section = 0 }
-      in_section && $1 == key ":" { next }
-      { print }' "config/$preset.yaml" > "$file"
-    grep -q "^  $name: $v\$" "$file" || { echo "config_ab.sh: no section $section: in config/$preset.yaml" >&2; exit 2; }
+    preset_with_key "config/$preset.yaml" "$section" "$name" "$v" "$out/configs/$preset-$v.yaml" || exit 2
   done
 done
 

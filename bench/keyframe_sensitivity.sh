@@ -14,6 +14,7 @@
 # each run and the median, min, max and max/min per group.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. bench/lib/preset_key.sh
 office_seed=1 kitti=${PLSLAM_SHARED_DIR:-../shared}/data/kitti/sequences/06
 while [ $# -gt 1 ]; do
   case "$1" in
@@ -33,12 +34,7 @@ summary="$out/summary.txt"
 # section's header when the preset leaves it at its default); prints the file's path.
 config() {
   local file="$out/configs/$1-$3-$4.yaml"
-  awk -v section="$2:" -v key="$3" -v value="$4" '
-    $0 == section { in_section = 1; print; print "  " key ": " value; next }
-    /^[^ #]/ { in_section = 0 }
-    in_section && $1 == key ":" { next }
-    { print }' "config/$1.yaml" > "$file"
-  grep -q "^  $3: $4\$" "$file" || { echo "keyframe_sensitivity.sh: no section $2 in config/$1.yaml" >&2; exit 2; }
+  preset_with_key "config/$1.yaml" "$2" "$3" "$4" "$file" || exit 2
   echo "$file"
 }
 # run GROUP LABEL DATASET CONFIG [ARGS...]: one deterministic run, one summary line.
