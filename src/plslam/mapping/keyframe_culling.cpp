@@ -14,11 +14,13 @@ bool is_redundant(const map::KeyFrame& k, const KeyframeCullingOptions& o) {
     ++total;
     if (mp->observation_weight() <= o.observers) continue;
     const int level = d.keypoints[i].octave;
+    // Visited under the point's lock, without copying its list: is_bad() is lock-free and a
+    // keyframe's keypoints never change.
     int seen = 0;
-    for (const auto& [other, idx] : mp->observation_list()) {
-      if (other == &k || other->is_bad()) continue;
-      if (other->data().keypoints[static_cast<std::size_t>(idx)].octave <= level + 1 && ++seen >= o.observers) break;
-    }
+    mp->for_each_observation([&](const map::KeyFrame* other, int idx) {
+      if (seen >= o.observers || other == &k || other->is_bad()) return;
+      if (other->data().keypoints[static_cast<std::size_t>(idx)].octave <= level + 1) ++seen;
+    });
     if (seen >= o.observers) ++redundant;
   }
   return total > 0 && redundant > o.redundancy * total;
