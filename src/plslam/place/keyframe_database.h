@@ -80,8 +80,8 @@ class KeyframeDatabase {
   int feature_levels_up_;
   mutable std::mutex mutex_;
   // Each indexed keyframe has a slot; the inverted file lists slots, so that a query counts
-  // common words in a plain array (with an ordered map per query this was 1.4 % of a street
-  // run's CPU). Freed slots are reused.
+  // common words in a plain array (an ordered map per query took 0.66 % of a sequential street
+  // loop's samples, the array 0.23 %). Freed slots are reused.
   struct Slot {
     map::KeyFrame* keyframe = nullptr;  // null: free
     std::shared_ptr<const PlaceDescription> description;
