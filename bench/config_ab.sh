@@ -10,7 +10,8 @@
 # both euroc preset). Renders already in OUT/street, OUT/office and OUT/corridor (or symlinks
 # there) are reused. OUT/summary.txt has each run's median tracking ms, ATE, keyframes and median
 # stereo points and lines per frame, then per sequence and value the medians, the ATE range, and
-# the ratio of tracking ms to the first value's.
+# the ratio of tracking ms to the first value's. bench/guided_lines_ab.sh is this script for
+# lines.guided_stereo.
 # Timings are only comparable within one sitting: run nothing else meanwhile.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,6 +33,10 @@ section=${key%%.*} name=${key#*.}
 plslam=${PLSLAM:-build/plslam}
 shared=${PLSLAM_SHARED_DIR:-../shared}
 [ -x "$plslam" ] || { echo "config_ab.sh: $plslam not built" >&2; exit 2; }
+case " $sequences " in
+  *" kitti06 "*|*" kitti01 "*)
+    [ -d "$shared/data/kitti/sequences/06" ] || { echo "config_ab.sh: no KITTI excerpts under $shared/data" >&2; exit 2; } ;;
+esac
 mkdir -p "$out/configs" "$out/runs"
 summary="$out/summary.txt"
 : > "$summary"
@@ -101,7 +106,9 @@ for line in open(sys.argv[1]):
         c["ate"].append(float(f[8]))
         c["kf"].append(float(f[10]))
         c["points"].append(float(f[14]))
-print(f"per sequence and value: median tracking ms (ratio to {values[0]}), median ATE m (min-max), median keyframes, median stereo points")
+        c["lines"].append(float(f[16]))
+print(f"per sequence and value: median tracking ms (ratio to {values[0]}), median ATE m (min-max), median keyframes, "
+      "median stereo points and lines")
 for name in dict.fromkeys(k[0] for k in cells):
     base = cells.get((name, values[0]))
     for v in values:
@@ -111,5 +118,6 @@ for name in dict.fromkeys(k[0] for k in cells):
         ms = statistics.median(c["ms"])
         ratio = f" ({ms / statistics.median(base['ms']):.3f}x)" if base else ""
         print(f"{name} {v}: {ms:.2f} ms{ratio}, ATE {statistics.median(c['ate']):.4f} ({min(c['ate']):.4f}-{max(c['ate']):.4f}), "
-              f"{statistics.median(c['kf']):.0f} keyframes, {statistics.median(c['points']):.0f} stereo points")
+              f"{statistics.median(c['kf']):.0f} keyframes, {statistics.median(c['points']):.0f} stereo points, "
+              f"{statistics.median(c['lines']):.0f} stereo lines")
 EOF
