@@ -1,7 +1,9 @@
+#include <pthread.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <string>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -25,6 +27,27 @@ TEST(ThreadPriority, LowersOnlyTheCallingThread) {
   EXPECT_EQ(inside, before);  // a new thread starts at its creator's value
   EXPECT_EQ(after_call, std::min(before + 3, 19));
   EXPECT_EQ(my_nice(), before);
+}
+
+std::string my_name() {
+  char name[16] = {};
+  pthread_getname_np(pthread_self(), name, sizeof(name));
+  return name;
+}
+
+TEST(ThreadName, NamesOnlyTheCallingThreadAndCutsAtFifteenCharacters) {
+  const std::string before = my_name();
+  std::string inside, cut;
+  std::thread t([&] {
+    ASSERT_TRUE(name_this_thread("plslam-mapping"));
+    inside = my_name();
+    ASSERT_TRUE(name_this_thread("plslam-a-name-longer-than-fifteen"));
+    cut = my_name();
+  });
+  t.join();
+  EXPECT_EQ(inside, "plslam-mapping");
+  EXPECT_EQ(cut, "plslam-a-name-l");
+  EXPECT_EQ(my_name(), before);
 }
 
 }  // namespace

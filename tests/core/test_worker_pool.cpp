@@ -1,9 +1,12 @@
 // WorkerPool: every chunk runs exactly once, on several threads, exceptions come back to the
 // caller, and a chunked reduction is bit-identical whatever the scheduling.
+#include <pthread.h>
+
 #include <atomic>
 #include <mutex>
 #include <numeric>
 #include <set>
+#include <string>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -41,6 +44,25 @@ TEST(WorkerPool, UsesMoreThanTheCallingThread) {
     for (int i = 0; i < 2000 && started.load() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   });
   EXPECT_EQ(ids.size(), 2u);
+}
+
+TEST(WorkerPool, WorkersCarryThePoolsName) {
+  WorkerPool pool(2, "test-pool");
+  std::mutex mu;
+  std::set<std::string> names;
+  std::atomic<int> started{0};
+  pool.run(2, [&](int) {  // as above: both chunks at once, so one runs on the worker
+    char name[16] = {};
+    pthread_getname_np(pthread_self(), name, sizeof(name));
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      names.insert(name);
+    }
+    ++started;
+    for (int i = 0; i < 2000 && started.load() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  });
+  ASSERT_EQ(names.size(), 2u);
+  EXPECT_EQ(names.count("test-pool"), 1u);  // the caller keeps its own name
 }
 
 TEST(WorkerPool, RethrowsTheFirstExceptionAndStaysUsable) {

@@ -10,6 +10,7 @@
 #include <exception>
 #include <functional>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -18,8 +19,8 @@ namespace plslam::core {
 class WorkerPool {
  public:
   // threads: how many threads run the chunks, the caller's included (so threads - 1 workers are
-  // started); <= 0 means one per hardware thread.
-  explicit WorkerPool(int threads);
+  // started); <= 0 means one per hardware thread. The workers carry `name` (see name_this_thread).
+  explicit WorkerPool(int threads, const std::string& name = "plslam-pool");
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;

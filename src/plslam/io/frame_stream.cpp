@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "plslam/core/error.h"
+#include "plslam/core/thread_priority.h"
 
 namespace plslam::io {
 
@@ -10,7 +11,10 @@ FrameStream::FrameStream(const Dataset& dataset, std::size_t capacity)
     : dataset_(dataset),
       capacity_(capacity == 0 ? 1 : capacity),
       input_frames_(dataset.size()),
-      worker_([this] { run(); }) {}
+      worker_([this] {
+        core::name_this_thread("plslam-loader");
+        run();
+      }) {}
 
 FrameStream::~FrameStream() {
   {

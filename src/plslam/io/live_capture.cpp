@@ -1,9 +1,14 @@
 #include "plslam/io/live_capture.h"
 
+#include "plslam/core/thread_priority.h"
+
 namespace plslam::io {
 
 LiveCapture::LiveCapture(std::unique_ptr<FrameSource> source)
-    : source_(std::move(source)), name_(source_->name()), worker_([this] { run(); }) {}
+    : source_(std::move(source)), name_(source_->name()), worker_([this] {
+        core::name_this_thread("plslam-capture");
+        run();
+      }) {}
 
 LiveCapture::~LiveCapture() { stop(); }
 

@@ -183,6 +183,7 @@ LoopClosingStats LoopCloser::stats() const {
 void LoopCloser::run() {
   // Loop closing can wait; tracking cannot (a corrected loop is worth the same a frame later).
   core::lower_this_thread_priority(kBackgroundNice);
+  core::name_this_thread("plslam-loop");
   std::unique_lock lock(queue_mutex_);
   for (;;) {
     cv_.wait(lock, [this] { return (!queue_.empty() && pauses_ == 0) || stop_requested_; });
@@ -389,6 +390,7 @@ void LoopCloser::start_global_ba() {
   }
   gba_thread_ = std::thread([this] {
     core::lower_this_thread_priority(kBackgroundNice);
+    core::name_this_thread("plslam-gba");
     global_ba();
     {
       std::lock_guard lock(gba_mutex_);

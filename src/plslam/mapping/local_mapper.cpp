@@ -1,6 +1,7 @@
 #include "plslam/mapping/local_mapper.h"
 
 #include "plslam/core/stopwatch.h"
+#include "plslam/core/thread_priority.h"
 
 #include <algorithm>
 #include <chrono>
@@ -29,7 +30,10 @@ LocalMapper::~LocalMapper() { stop(); }
 
 void LocalMapper::start() {
   if (thread_.joinable()) return;
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this] {
+    core::name_this_thread("plslam-mapping");
+    run();
+  });
 }
 
 void LocalMapper::stop() {

@@ -402,7 +402,7 @@ class SchurLm {
           const BaPassSpec& spec, BaState* s)
       : ctx_{cam, opt, spec.robust}, p_(p), opt_(opt), spec_(spec), s_(s),
         threads_(std::max(1, opt.num_threads)) {
-    if (threads_ > 1) pool_ = std::make_unique<core::WorkerPool>(threads_);
+    if (threads_ > 1) pool_ = std::make_unique<core::WorkerPool>(threads_, "plslam-ba");
     build(spec.excluded);
   }
 

@@ -142,7 +142,7 @@ bool render_all(const Sequence& seq, const Progress& progress, int threads, cons
   // Chunks of 8 frames, each with its own renderer (it keeps per-thread scratch images).
   constexpr std::size_t kChunk = 8;
   std::unique_ptr<core::WorkerPool> pool;
-  if (threads != 1) pool = std::make_unique<core::WorkerPool>(threads);
+  if (threads != 1) pool = std::make_unique<core::WorkerPool>(threads, "plslam-synth");
   const std::size_t per_batch = in_order ? kChunk * 2 * static_cast<std::size_t>(pool ? pool->threads() : 1) : n;
   std::vector<StereoImages> batch;
   for (std::size_t first = 0; first < n; first += per_batch) {

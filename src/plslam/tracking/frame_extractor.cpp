@@ -30,7 +30,7 @@ FrameExtractor::FrameExtractor(const StereoCalibration& calib, FrameExtractorOpt
       options_(std::move(options)),
       left_orb_(options_.orb),
       right_orb_(matching::right_image_options(options_.orb, options_.right_points_factor)),
-      lanes_(std::make_unique<core::WorkerPool>(2)) {
+      lanes_(std::make_unique<core::WorkerPool>(2, "plslam-lanes")) {
   options_.line_extractor.min_angle_from_horizontal_deg = options_.stereo_lines.min_angle_from_horizontal_deg;
   options_.stereo_points.bf = calib_.bf();
   options_.stereo_points.baseline = calib_.baseline;

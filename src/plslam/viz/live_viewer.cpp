@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "plslam/core/error.h"
+#include "plslam/core/thread_priority.h"
 #include "plslam/map/map_snapshot.h"
 
 namespace plslam::viz {
@@ -182,7 +183,10 @@ LiveViewer::LiveViewer(LiveViewerOptions options, const map::Map& map, SceneInfo
   first->info.revision = 0;
   last_ = first;
   server_.publish(0, [first] { return scene_document(first->map, first->info).dump(); }, {});
-  thread_ = std::thread([this] { publish_loop(); });
+  thread_ = std::thread([this] {
+    core::name_this_thread("plslam-viewer");
+    publish_loop();
+  });
 }
 
 LiveViewer::~LiveViewer() {

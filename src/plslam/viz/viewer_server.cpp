@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "plslam/core/error.h"
+#include "plslam/core/thread_priority.h"
 
 namespace plslam::viz {
 namespace {
@@ -216,7 +217,10 @@ ViewerServer::ViewerServer(ViewerServerOptions options) : impl_(std::make_unique
                                      options.host, options.port));
   }
   impl_->port = port;
-  impl_->thread = std::thread([impl] { impl->server.listen_after_bind(); });
+  impl_->thread = std::thread([impl] {
+    core::name_this_thread("plslam-http");
+    impl->server.listen_after_bind();
+  });
   // stop() before the loop runs would not reach it: wait until it does.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   while (!server.is_running() && std::chrono::steady_clock::now() < deadline) {
