@@ -21,7 +21,8 @@
 # Default dataset: the office loop (480 frames, seed 1), rendered into OUT/office when missing.
 # OUT/summary.txt has one line per mode: the runs' medians and the ratio of medians to `off`; the
 # median (min-max) of each run's ratio to the `off` run of its own round; and for the browser
-# modes the median CPU seconds Chromium used from opening the page to the run's final state.
+# modes the median CPU seconds Chromium used from opening the page to the run's final state, in
+# all and by process type (browser, renderer, gpu-process, utility).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=5
@@ -120,9 +121,10 @@ run_one() {  # mode, index
   python3 -c "import json; print(json.load(open('$dir/stats.json'))['tracking_ms']['median'])" >> "$out/$mode.txt"
   # Chromium's CPU seconds from the page's opening to the run's final state (the browser modes)
   sed -n 's/.*, \([0-9.]*\) s since the page was opened/\1/p' "$dir.browser" 2>/dev/null >> "$out/$mode.cpu" || true
+  sed -n 's/^since the page was opened, by process: //p' "$dir.browser" 2>/dev/null >> "$out/$mode.split" || true
 }
 
-rm -f "$out"/{off,poller,browser,niced,idle,open}.{txt,cpu}
+rm -f "$out"/{off,poller,browser,niced,idle,open}.{txt,cpu,split}
 for i in $(seq "$runs"); do
   for mode in $modes; do
     run_one "$mode" "$i"
@@ -140,6 +142,13 @@ for m in modes:
     paired = sorted(a / b for a, b in zip(runs[m], runs["off"]))
     cpu = [float(x) for x in open(f"{out}/{m}.cpu")] if os.path.exists(f"{out}/{m}.cpu") else []
     cpu = f", Chromium CPU from page open {statistics.median(cpu):.2f} s" if cpu else ""
+    if cpu and os.path.exists(f"{out}/{m}.split"):  # lines of "renderer 1.23 s, gpu-process 0.80 s, ..."
+        parts = {}
+        for line in open(f"{out}/{m}.split"):
+            for item in line.strip().split(", "):
+                name, seconds, _ = item.split(" ")
+                parts.setdefault(name, []).append(float(seconds))
+        cpu += " (" + ", ".join(f"{k} {statistics.median(v):.2f}" for k, v in sorted(parts.items())) + ")"
     listed = " ".join(f"{x:.1f}" for x in runs[m])
     print(f"{m:8s} median {med:.2f} ms/frame (runs: {listed}), ratio to off {med / statistics.median(runs['off']):.3f}, "
           f"per round {statistics.median(paired):.3f} ({paired[0]:.3f}-{paired[-1]:.3f}){cpu}")

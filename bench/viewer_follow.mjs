@@ -16,24 +16,35 @@ const { chromium } = createRequire(path.join(web, 'package.json'))('playwright-c
 const [url, mode] = process.argv.slice(2);
 
 // CPU seconds used so far by this process's descendants: Chromium's browser, renderer and GPU
-// processes, and those of them already reaped by their parent (cutime, cstime).
+// processes, and those of them already reaped by their parent (cutime, cstime). Returns the total
+// and the split by Chromium's process type (--type=renderer, gpu-process, utility; none: browser).
 function chromiumCpuSeconds() {
-  const parent = new Map(), ticks = new Map();
+  const parent = new Map(), ticks = new Map(), type = new Map();
   for (const name of fs.readdirSync('/proc')) {
     if (!/^[0-9]+$/.test(name)) continue;
-    let stat;
-    try { stat = fs.readFileSync(`/proc/${name}/stat`, 'utf8'); } catch { continue; }   // gone
+    let stat, cmdline;
+    try {
+      stat = fs.readFileSync(`/proc/${name}/stat`, 'utf8');
+      cmdline = fs.readFileSync(`/proc/${name}/cmdline`, 'utf8');
+    } catch { continue; }   // gone
     const f = stat.slice(stat.lastIndexOf(')') + 2).split(' ');   // f[0] is field 3, the state
     parent.set(Number(name), Number(f[1]));
     ticks.set(Number(name), Number(f[11]) + Number(f[12]) + Number(f[13]) + Number(f[14]));
+    type.set(Number(name), cmdline.match(/--type=([a-z-]+)/)?.[1] ?? 'browser');
   }
+  const byType = {};
   let sum = 0;
   for (const [pid, t] of ticks) {
     for (let p = parent.get(pid); p !== undefined && p > 1; p = parent.get(p)) {
-      if (p === process.pid) { sum += t; break; }
+      if (p === process.pid) {
+        sum += t;
+        byType[type.get(pid)] = (byType[type.get(pid)] ?? 0) + t;
+        break;
+      }
     }
   }
-  return sum / 100;   // USER_HZ, 100 on Linux
+  for (const k of Object.keys(byType)) byType[k] /= 100;
+  return { total: sum / 100, byType };   // USER_HZ, 100 on Linux
 }
 
 const browser = await chromium.launch({
@@ -63,7 +74,10 @@ try {
   }
   await page.waitForFunction(() => window.plslamViewer?.final === true, null, { timeout: 600000, polling: 500 });
   const cpu = chromiumCpuSeconds();
-  console.log(`chromium cpu ${cpu.toFixed(2)} s, ${(cpu - cpuAtOpen).toFixed(2)} s since the page was opened`);
+  console.log(`chromium cpu ${cpu.total.toFixed(2)} s, ${(cpu.total - cpuAtOpen.total).toFixed(2)} s since the page was opened`);
+  const split = Object.keys(cpu.byType).sort()
+    .map((k) => `${k} ${(cpu.byType[k] - (cpuAtOpen.byType[k] ?? 0)).toFixed(2)} s`);
+  console.log(`since the page was opened, by process: ${split.join(', ')}`);
 } finally {
   await browser.close();
 }
