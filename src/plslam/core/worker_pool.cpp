@@ -9,10 +9,12 @@ namespace plslam::core {
 WorkerPool::WorkerPool(int threads, const std::string& name) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   workers_.reserve(static_cast<std::size_t>(threads - 1));
-  for (int i = 1; i < threads; ++i) workers_.emplace_back([this, name] {
+  for (int i = 1; i < threads; ++i) {
+    workers_.emplace_back([this, name] {
       name_this_thread(name.c_str());
       work_loop();
     });
+  }
 }
 
 WorkerPool::~WorkerPool() {
