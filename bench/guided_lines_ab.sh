@@ -9,8 +9,8 @@
 # default concurrent mode with loop closing, on KITTI 06 and 01 (frames 0-50), the rendered street
 # loop (300 frames, KITTI preset), the rendered office loop (480 frames) and the corridor loop (742
 # frames; both EuRoC preset). OUT/summary.txt has each run's median tracking ms, ATE, keyframes and
-# median stereo points and lines per frame, and per cell the medians and the guided/detected ratio
-# of tracking time.
+# median stereo points and lines per frame, and per cell the medians and the ratio of tracking time
+# to the guided (true) runs'.
 # Timings are only comparable within one sitting: run nothing else meanwhile.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -16,8 +16,9 @@ const { chromium } = createRequire(path.join(web, 'package.json'))('playwright-c
 const [url, mode] = process.argv.slice(2);
 
 // CPU seconds used so far by this process's descendants: Chromium's browser, renderer and GPU
-// processes, and those of them already reaped by their parent (cutime, cstime). Returns the total
-// and the split by Chromium's process type (--type=renderer, gpu-process, utility; none: browser).
+// processes, and those of them already reaped by their parent (cutime, cstime). Returns the split
+// by Chromium's process type (--type=renderer, gpu-process, utility; none: browser), a reaped
+// process's time counted under its parent's type, and the total.
 function chromiumCpuSeconds() {
   const parent = new Map(), ticks = new Map(), type = new Map();
   for (const name of fs.readdirSync('/proc')) {
@@ -33,18 +34,15 @@ function chromiumCpuSeconds() {
     type.set(Number(name), cmdline.match(/--type=([a-z-]+)/)?.[1] ?? 'browser');
   }
   const byType = {};
-  let sum = 0;
   for (const [pid, t] of ticks) {
     for (let p = parent.get(pid); p !== undefined && p > 1; p = parent.get(p)) {
       if (p === process.pid) {
-        sum += t;
-        byType[type.get(pid)] = (byType[type.get(pid)] ?? 0) + t;
+        byType[type.get(pid)] = (byType[type.get(pid)] ?? 0) + t / 100;   // USER_HZ, 100 on Linux
         break;
       }
     }
   }
-  for (const k of Object.keys(byType)) byType[k] /= 100;
-  return { total: sum / 100, byType };   // USER_HZ, 100 on Linux
+  return { total: Object.values(byType).reduce((a, b) => a + b, 0), byType };
 }
 
 const browser = await chromium.launch({
