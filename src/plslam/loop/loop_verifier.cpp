@@ -10,6 +10,7 @@
 #include "plslam/geometry/umeyama.h"
 #include "plslam/map/keyframe.h"
 #include "plslam/map/map_point.h"
+#include "plslam/optim/pose_only.h"
 
 namespace plslam::loop {
 namespace {
@@ -22,6 +23,8 @@ struct Pair {
   Eigen::Vector3d in_query, in_candidate;
   Eigen::Vector2d query_pixel, candidate_pixel;
   double query_sigma2, candidate_sigma2;  // level scale squared
+  float query_u_right;                     // -1 without a stereo match
+  int query_level;
 };
 
 bool is_inlier(const Pair& p, const geometry::SE3& T_qc, const geometry::SE3& T_cq, const geometry::StereoCamera& qcam,
@@ -77,7 +80,7 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
     const auto& ck = cdata.keypoints[static_cast<std::size_t>(m.train)];
     const double qs = qdata.level_scale(qk.octave), cs = cdata.level_scale(ck.octave);
     pairs.push_back({qp, cp, Tq * qp->position(), Tc * cp->position(), {qk.pt.x, qk.pt.y}, {ck.pt.x, ck.pt.y},
-                     qs * qs, cs * cs});
+                     qs * qs, cs * cs, qdata.u_right[static_cast<std::size_t>(m.query)], qk.octave});
   }
   if (static_cast<int>(pairs.size()) < o.min_matches) return std::nullopt;
   // 2. RANSAC over minimal 3-point alignments.
@@ -85,6 +88,7 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
   std::mt19937 rng(o.seed);
   std::uniform_int_distribution<std::size_t> pick(0, pairs.size() - 1);
   std::vector<std::size_t> best;
+  geometry::SE3 T;
   auto inliers_of = [&](const geometry::SE3& T) {
     const geometry::SE3 Ti = T.inverse();
     std::vector<std::size_t> in;
@@ -96,25 +100,41 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
   for (int it = 0; it < o.ransac_iterations; ++it) {
     const std::size_t a = pick(rng), b = pick(rng), c = pick(rng);
     if (a == b || b == c || a == c) continue;
-    geometry::SE3 T;
+    geometry::SE3 H;
     try {
-      T = align({&pairs[a], &pairs[b], &pairs[c]});
+      H = align({&pairs[a], &pairs[b], &pairs[c]});
     } catch (const std::invalid_argument&) {
       continue;
     }
-    auto in = inliers_of(T);
-    if (in.size() > best.size()) best = std::move(in);
+    auto in = inliers_of(H);
+    if (in.size() > best.size()) {
+      best = std::move(in);
+      T = H;
+    }
   }
   if (static_cast<int>(best.size()) < o.min_inliers) return std::nullopt;
-  // 3. Refine on the inliers until the set stops changing (a few rounds).
-  geometry::SE3 T;
+  // 3. Refine over pixel errors: the candidate's points, in its camera frame, seen by the query's
+  // keypoints (left pixel and right column), until the inliers stop changing. A 3D fit would let far
+  // points, whose depths are loose, pull the pose: an unweighted Umeyama refit once slid a street
+  // loop 2.7 m and 3.8 degrees onto a facade's repeated windows, keeping 25 of the hypothesis' 39
+  // inliers. So a refinement that loses support is not taken.
+  optim::PoseOnlyOptions po;
+  po.scale_factor = qdata.scale_factor;
   for (int round = 0; round < 5; ++round) {
-    std::vector<const Pair*> in;
-    for (std::size_t i : best) in.push_back(&pairs[i]);
-    T = align(in);
-    auto next = inliers_of(T);
+    std::vector<optim::PosePointTerm> terms;
+    for (std::size_t i : best) {
+      optim::PosePointTerm t;
+      t.world = pairs[i].in_candidate;
+      t.obs.measurement = {pairs[i].query_pixel.x(), pairs[i].query_pixel.y(), pairs[i].query_u_right};
+      t.obs.has_right = pairs[i].query_u_right >= 0;
+      t.obs.level = pairs[i].query_level;
+      terms.push_back(t);
+    }
+    const geometry::SE3 refined = optim::optimize_pose(qcam, T, terms, {}, po).T_cw.normalized();
+    auto next = inliers_of(refined);
+    if (next.size() < best.size()) break;
+    T = refined;
     if (next == best) break;
-    if (static_cast<int>(next.size()) < o.min_inliers) return std::nullopt;
     best = std::move(next);
   }
   LoopConstraint out;

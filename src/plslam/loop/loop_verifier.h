@@ -2,10 +2,9 @@
 // Geometric verification of a loop candidate in SE(3): stereo fixes the scale, so the relative
 // pose of the two keyframes is a rigid transform. From BoW matches between their map points, a
 // RANSAC over 3-point Umeyama alignments (seeded), scored by reprojection errors in both keyframes
-// (depth errors grow with depth squared, pixel errors do not), refined by least squares on the
-// inliers (a refinement over reprojection errors in both keyframes, and search by projection for
-// more matches, are next: issue 15). Perceptual
-// aliasing gives matches that agree on no single transform, and is rejected.
+// (depth errors grow with depth squared, pixel errors do not), then refined over the query's pixel
+// errors of the inliers (loop closing then searches the place by projection and refines again).
+// Perceptual aliasing gives matches that agree on no single transform, and is rejected.
 #include <cstdint>
 #include <optional>
 #include <utility>
