@@ -88,7 +88,6 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
   std::mt19937 rng(o.seed);
   std::uniform_int_distribution<std::size_t> pick(0, pairs.size() - 1);
   std::vector<std::size_t> best;
-  geometry::SE3 T;
   auto inliers_of = [&](const geometry::SE3& T) {
     const geometry::SE3 Ti = T.inverse();
     std::vector<std::size_t> in;
@@ -97,6 +96,7 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
     }
     return in;
   };
+  geometry::SE3 T;  // the hypothesis of `best`
   for (int it = 0; it < o.ransac_iterations; ++it) {
     const std::size_t a = pick(rng), b = pick(rng), c = pick(rng);
     if (a == b || b == c || a == c) continue;
