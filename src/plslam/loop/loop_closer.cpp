@@ -242,13 +242,7 @@ std::optional<LoopConstraint> LoopCloser::confirm(map::KeyFrame* kf, const LoopD
   std::vector<std::size_t> term_keypoint;
   for (std::size_t i = 0; i < matched.size(); ++i) {
     if (!matched[i]) continue;
-    const auto& kp = qd.keypoints[i];
-    optim::PosePointTerm t;
-    t.world = matched[i]->position();
-    t.obs.measurement = {kp.pt.x, kp.pt.y, qd.u_right[i]};
-    t.obs.has_right = qd.u_right[i] >= 0;
-    t.obs.level = kp.octave;
-    terms.push_back(t);
+    terms.push_back({matched[i]->position(), qd.point_observation(i)});
     term_keypoint.push_back(i);
   }
   if (static_cast<int>(terms.size()) < options_.min_projection_inliers) return std::nullopt;

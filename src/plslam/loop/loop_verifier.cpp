@@ -23,8 +23,7 @@ struct Pair {
   Eigen::Vector3d in_query, in_candidate;
   Eigen::Vector2d query_pixel, candidate_pixel;
   double query_sigma2, candidate_sigma2;  // level scale squared
-  float query_u_right;                     // -1 without a stereo match
-  int query_level;
+  std::size_t query_keypoint;
 };
 
 bool is_inlier(const Pair& p, const geometry::SE3& T_qc, const geometry::SE3& T_cq, const geometry::StereoCamera& qcam,
@@ -80,7 +79,7 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
     const auto& ck = cdata.keypoints[static_cast<std::size_t>(m.train)];
     const double qs = qdata.level_scale(qk.octave), cs = cdata.level_scale(ck.octave);
     pairs.push_back({qp, cp, Tq * qp->position(), Tc * cp->position(), {qk.pt.x, qk.pt.y}, {ck.pt.x, ck.pt.y},
-                     qs * qs, cs * cs, qdata.u_right[static_cast<std::size_t>(m.query)], qk.octave});
+                     qs * qs, cs * cs, static_cast<std::size_t>(m.query)});
   }
   if (static_cast<int>(pairs.size()) < o.min_matches) return std::nullopt;
   // 2. RANSAC over minimal 3-point alignments.
@@ -123,12 +122,7 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
   for (int round = 0; round < 5; ++round) {
     std::vector<optim::PosePointTerm> terms;
     for (std::size_t i : best) {
-      optim::PosePointTerm t;
-      t.world = pairs[i].in_candidate;
-      t.obs.measurement = {pairs[i].query_pixel.x(), pairs[i].query_pixel.y(), pairs[i].query_u_right};
-      t.obs.has_right = pairs[i].query_u_right >= 0;
-      t.obs.level = pairs[i].query_level;
-      terms.push_back(t);
+      terms.push_back({pairs[i].in_candidate, qdata.point_observation(pairs[i].query_keypoint)});
     }
     const geometry::SE3 refined = optim::optimize_pose(qcam, T, terms, {}, po).T_cw.normalized();
     auto next = inliers_of(refined);

@@ -5,6 +5,14 @@
 
 namespace plslam::map {
 
+optim::StereoPointObservation FrameData::point_observation(std::size_t i, double max_depth_baselines) const {
+  optim::StereoPointObservation o;
+  o.measurement = {keypoints[i].pt.x, keypoints[i].pt.y, u_right[i]};
+  o.has_right = stereo_constraint(i, max_depth_baselines);
+  o.level = keypoints[i].octave;
+  return o;
+}
+
 void FrameData::build_grid() {
   constexpr std::size_t kCells = static_cast<std::size_t>(kGridCols * kGridRows);
   const double cw = static_cast<double>(calib.width) / kGridCols;

@@ -10,6 +10,7 @@
 
 #include "plslam/core/types.h"
 #include "plslam/features/line_segment.h"
+#include "plslam/optim/observations.h"
 
 namespace plslam::map {
 
@@ -61,6 +62,9 @@ struct FrameData {
   bool stereo_constraint(std::size_t i, double max_depth_baselines) const {
     return u_right[i] >= 0 && (max_depth_baselines <= 0 || depth[i] <= max_depth_baselines * calib.baseline);
   }
+  // Keypoint i as an optimiser's observation: (u_l, v, u_r), its level, and the right column used
+  // as stereo_constraint(i, max_depth_baselines) says. Keyframe and point indices are left 0.
+  optim::StereoPointObservation point_observation(std::size_t i, double max_depth_baselines = 0) const;
 
   double level_scale(int level) const;        // scale_factor^level
   double level_sigma2(int level) const;       // scale_factor^(2 level)

@@ -38,13 +38,9 @@ void MapBaProblem::add_landmarks_of(const std::vector<map::KeyFrame*>& kfs) {
       const int ki = add_keyframe(k, true);
       const auto& d = k->data();
       const auto i = static_cast<std::size_t>(idx);
-      const auto& kp = d.keypoints[i];
-      optim::StereoPointObservation o;
+      optim::StereoPointObservation o = d.point_observation(i, far_stereo_baselines_);
       o.keyframe = ki;
       o.point = static_cast<int>(p);
-      o.measurement = {kp.pt.x, kp.pt.y, d.u_right[i]};
-      o.has_right = d.stereo_constraint(i, far_stereo_baselines_);
-      o.level = kp.octave;
       problem.point_observations.push_back(o);
       point_observers.push_back(k);
     }

@@ -303,12 +303,7 @@ int Tracker::optimize_pose(Frame& f, TrackStageTimes& t) {
   for (std::size_t i = 0; i < f.points.size(); ++i) {
     map::MapPoint* mp = f.points[i];
     if (!mp) continue;
-    optim::PosePointTerm term;
-    term.world = mp->position();
-    term.obs.measurement = {d.keypoints[i].pt.x, d.keypoints[i].pt.y, d.u_right[i]};
-    term.obs.has_right = d.stereo_constraint(i, options_.far_stereo_baselines);
-    term.obs.level = d.keypoints[i].octave;
-    pts.push_back(term);
+    pts.push_back({mp->position(), d.point_observation(i, options_.far_stereo_baselines)});
     pidx.push_back(i);
   }
   std::vector<optim::PoseLineTerm> lns;
