@@ -142,6 +142,8 @@ PYBIND11_MODULE(plslam, m) {
       .def_readonly("index", &TrackedFrame::index)
       .def_readonly("timestamp", &TrackedFrame::timestamp)
       .def_property_readonly("state", [](const TrackedFrame& f) { return std::string(to_string(f.state)); })
+      .def_property_readonly("frame_state", [](const TrackedFrame& f) { return std::string(to_string(f.frame_state)); },
+                             "tracked, relocalized, localized (trusted poses), recovering or lost")
       .def_readonly("tracked", &TrackedFrame::tracked)
       .def_property_readonly("pose", [](const TrackedFrame& f) { return Eigen::Matrix4d(f.T_world_camera.matrix()); },
                              "4x4 T_world_camera of the left camera")

@@ -58,18 +58,26 @@ struct SlamOptions {
 enum class TrackingState { kNotInitialized, kTracking, kLost };
 const char* to_string(TrackingState state);
 
+// What a frame's pose is worth: "tracked", "relocalized" (confirmed a relocalization) and
+// "localized" (in a loaded map, localization only) are poses plslam stands behind; "recovering"
+// (tracked from a relocalization not yet confirmed) and "lost" are not.
+enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized };
+const char* to_string(FrameState state);
+
 struct TrackedFrame {
   long index = 0;          // 0, 1, 2, ... in the order track() was called
   double timestamp = 0;    // seconds, as given
   TrackingState state = TrackingState::kNotInitialized;
-  bool tracked = false;    // T_world_camera is an estimate (false: not initialised or lost)
+  FrameState frame_state = FrameState::kLost;
+  // T_world_camera is a trusted estimate (frame_state tracked, relocalized or localized).
+  bool tracked = false;
   // The left camera in the world (maps camera coordinates to world coordinates); the world is the
   // first keyframe's camera, or the loaded map's world.
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
   int point_inliers = 0;
   int line_inliers = 0;
   bool keyframe = false;         // the frame became a keyframe
-  bool relocalized = false;      // found again in the map after being lost
+  bool relocalized = false;      // confirmed being found again in the map after being lost
   bool new_map_segment = false;  // lost for too long: a new, disconnected map started
   double tracking_ms = 0;        // images in to pose out
 };

@@ -83,7 +83,7 @@ def test_track_refuses_wrong_images_and_timestamps(office_short):
     with pytest.raises(ValueError):
         slam.track(np.zeros((2, 2, 2, 2), np.uint8), right, t)
     f = slam.track(left, right, t)
-    assert f.index == 0 and f.tracked and f.state == "tracking"
+    assert f.index == 0 and f.tracked and f.state == "tracking" and f.frame_state == "tracked"
     with pytest.raises(plslam.InputError, match="does not follow"):
         slam.track(left, right, t)
     slam.shutdown()

@@ -161,8 +161,14 @@ TEST(TimeRobustness, LostFrameIsMarkedAndNotInTheTrajectory) {
   EXPECT_EQ(r.stats["new_map_segments"]["count"], 0);
   const auto untracked = r.stats["untracked_kitti_lines"].get<std::vector<std::size_t>>();
   EXPECT_NE(std::find(untracked.begin(), untracked.end(), 7u), untracked.end());
+  // It lands where the motion model carries the frames before the loss, 0.2 s earlier: it
+  // continues the trusted trajectory and is confirmed at once (relocalization.continuity_s), with
+  // no recovering frames. trajectory.tum holds the trusted poses, the kitti file a line per frame.
+  EXPECT_EQ(r.stats["frame_states"]["recovering"], 0);
+  EXPECT_EQ(r.stats["frame_states"]["relocalized"], 1);
   const auto tum = io::read_trajectory(r.out / "trajectory.tum", io::TrajectoryFormat::kTum);
   EXPECT_EQ(tum.size(), 14u - lost.size());
+  EXPECT_EQ(tum.size(), r.stats["tracked_frames"].get<std::size_t>());
   EXPECT_EQ(io::read_trajectory(r.out / "trajectory.kitti", io::TrajectoryFormat::kKitti).size(), 14u);
 }
 

@@ -16,6 +16,7 @@ tracking::FrameRecord record(long id, double x, bool tracked) {
   // No reference keyframe: T_cr is T_cw itself. Camera at x on the x axis: T_cw translation -x.
   r.T_cr = geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-x, 0, 0));
   r.tracked = tracked;
+  r.state = tracked ? tracking::FrameState::kTracked : tracking::FrameState::kLost;
   return r;
 }
 
@@ -38,6 +39,19 @@ TEST(InputAlignedTrajectory, OneLinePerInputFrameWithGapsHeld) {
     EXPECT_DOUBLE_EQ(a.poses[i].t, 0.1 * static_cast<double>(i));
   }
   EXPECT_EQ(a.untracked, (std::vector<std::size_t>{0, 3, 5, 7}));
+}
+
+TEST(InputAlignedTrajectory, RecoveringFramesAreNotTrustedLines) {
+  // 0 tracked, 1-2 recovering from a relocalization (poses, but not trusted), 3 relocalized.
+  auto recs = std::vector<tracking::FrameRecord>{record(0, 0, true), record(1, 50, true), record(2, 51, true),
+                                                 record(3, 3, true)};
+  recs[1].state = recs[2].state = tracking::FrameState::kRecovering;
+  recs[3].state = tracking::FrameState::kRelocalized;
+  const auto a = align_to_input(recs, times(4));
+  ASSERT_EQ(a.poses.size(), 4u);
+  const double expected_x[] = {0, 0, 0, 3};
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(a.poses[i].T.translation().x(), expected_x[i], 1e-12) << i;
+  EXPECT_EQ(a.untracked, (std::vector<std::size_t>{1, 2}));
 }
 
 TEST(InputAlignedTrajectory, NothingTrackedGivesNoPoses) {

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "plslam/core/error.h"
+#include "plslam/eval/frame_log.h"
 #include "plslam/io/dataset.h"
 #include "plslam/system/map_file.h"
 #include "plslam/system/slam_system.h"
@@ -84,6 +85,22 @@ class MapReuse : public ::testing::Test {
 
 std::unique_ptr<test::TempDir> MapReuse::tmp_;
 fs::path MapReuse::cache_;
+
+// frames.csv's state column, frame by frame.
+std::vector<std::string> frame_states(const fs::path& run) {
+  const auto log = eval::read_frame_log(run / "frames.csv");
+  const auto col = std::find(log.header.begin(), log.header.end(), "state") - log.header.begin();
+  std::vector<std::string> out;
+  for (const auto& row : log.rows) out.push_back(row[static_cast<std::size_t>(col)]);
+  return out;
+}
+
+std::size_t tum_rows(const fs::path& file) {
+  std::ifstream in(file);
+  std::size_t n = 0;
+  for (std::string line; std::getline(in, line);) n += !line.empty() && line[0] != '#';
+  return n;
+}
 
 std::unique_ptr<system::System> make_system(const io::Dataset& ds, bool localization_only = false) {
   auto options = system::load_system_options(ds.format(), std::nullopt);
@@ -271,7 +288,26 @@ TEST_F(MapReuse, LocalizationOnlyTracksEveryFrameInTheMapFrameAndAddsNothing) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto stats = nlohmann::json::parse(test::read_file(out.path() / "loc" / "stats.json"));
   const auto contents = system::load_map_file(map_file());
-  EXPECT_EQ(stats["tracked_frames"], kFrames);
+  // The first frame is relocalized in the map, and the frames recover from it until it is
+  // confirmed (EuRoC preset: 5 frames, each with inliers all over the map's part of the image);
+  // every frame from then on is localized.
+  const auto states = frame_states(out.path() / "loc");
+  ASSERT_EQ(states.size(), static_cast<std::size_t>(kFrames));
+  const auto first = std::find(states.begin(), states.end(), "localized") - states.begin();
+  EXPECT_GE(first, 4);
+  EXPECT_LE(first, 10);
+  for (long i = 0; i < kFrames; ++i) EXPECT_EQ(states[i], i < first ? "recovering" : "localized") << i;
+  const auto localized = static_cast<std::size_t>(kFrames - first);
+  EXPECT_EQ(stats["tracked_frames"], localized);
+  EXPECT_EQ(stats["frame_states"]["localized"], localized);
+  EXPECT_EQ(stats["frame_states"]["recovering"], first);
+  EXPECT_EQ(stats["relocalizations"]["frames"], nlohmann::json::array({0}));
+  // trajectory.tum holds only the trusted poses: the localized ones.
+  EXPECT_EQ(tum_rows(out.path() / "loc" / "trajectory.tum"), localized);
+  EXPECT_NE(r.out.find(fmt::format("frame states: tracked 0, relocalized 0, localized {}, recovering {}, lost 0",
+                                   localized, first)),
+            std::string::npos)
+      << r.out;
   EXPECT_EQ(stats["keyframes"], contents.keyframes.size());
   EXPECT_EQ(stats["map"]["localization_only"], true);
   // The map's world is the mapping run's: positions agree with the ground truth through the
@@ -284,6 +320,31 @@ TEST_F(MapReuse, LocalizationOnlyTracksEveryFrameInTheMapFrameAndAddsNothing) {
   EXPECT_EQ(after.lines.size(), contents.lines.size());
 }
 
+TEST_F(MapReuse, ALocalizationUnderMinLocalizedExitsThreeWithItsOutputsWritten) {
+  test::TempDir out;
+  const auto r = localize(map_file(), out.path() / "loc", " --localize --min-localized 1");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("--min-localized 1;"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(map_file().string()), std::string::npos) << r.err;
+  // One error line (the rest of stderr is the log).
+  const auto error_lines = [](const std::string& text) {
+    std::size_t n = 0;
+    for (std::size_t at = text.find("plslam: error:"); at != std::string::npos; at = text.find("plslam: error:", at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(error_lines(r.err), 1u) << r.err;
+  for (const char* f : {"trajectory.tum", "frames.csv", "stats.json", "keyframes.tum"}) {
+    EXPECT_TRUE(fs::exists(out.path() / "loc" / f)) << f;
+  }
+  const auto stats = nlohmann::json::parse(test::read_file(out.path() / "loc" / "stats.json"));
+  EXPECT_EQ(stats["map"]["min_localized"], 1.0);
+  // --min-localized is for --localize runs only.
+  EXPECT_EQ(test::run_cli("run \"" + sequence().string() + "\" --out \"" + (out.path() / "x").string() +
+                          "\" --load-map \"" + map_file().string() + "\" --min-localized 0.5")
+                .exit_code,
+            2);
+}
+
 TEST_F(MapReuse, MappingContinuesOnALoadedMap) {
   test::TempDir out;
   const fs::path first = out.path() / "first.plmap", both = out.path() / "both.plmap";
@@ -291,11 +352,20 @@ TEST_F(MapReuse, MappingContinuesOnALoadedMap) {
                          "\" --quiet --sequential --max-frames 20 --save-map \"" + first.string() + "\"");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = test::run_cli("run \"" + sequence().string() + "\" --out \"" + (out.path() / "b").string() +
-                    "\" --quiet --sequential --start 18 --load-map \"" + first.string() + "\" --save-map \"" +
+                    "\" --quiet --sequential --start 10 --load-map \"" + first.string() + "\" --save-map \"" +
                     both.string() + "\"");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto stats = nlohmann::json::parse(test::read_file(out.path() / "b" / "stats.json"));
-  EXPECT_EQ(stats["tracked_frames"], kFrames - 18);
+  // Frame 10 relocalizes in the loaded map; its frames recover (no keyframe) until it is confirmed,
+  // then tracking maps on: tracked, relocalized once, tracked.
+  const auto states = frame_states(out.path() / "b");
+  ASSERT_EQ(states.size(), static_cast<std::size_t>(kFrames - 10));
+  const auto confirmed = std::find(states.begin(), states.end(), "relocalized") - states.begin();
+  ASSERT_LT(confirmed, static_cast<long>(states.size()));
+  for (long i = 0; i < static_cast<long>(states.size()); ++i) {
+    EXPECT_EQ(states[i], i < confirmed ? "recovering" : i == confirmed ? "relocalized" : "tracked") << i;
+  }
+  EXPECT_EQ(stats["tracked_frames"], kFrames - 10 - confirmed);
   EXPECT_EQ(stats["new_map_segments"]["count"], 0);
   EXPECT_EQ(stats["relocalizations"]["count"], 1) << stats["relocalizations"].dump();
   const auto a = system::load_map_file(first), b = system::load_map_file(both);

@@ -1,4 +1,5 @@
 // plslam/plslam.h: what an embedding program sees.
+#include <algorithm>
 #include <unistd.h>
 
 #include <fstream>
@@ -144,12 +145,24 @@ TEST(PublicApi, SavedMapIsLoadedAndLocalizedIn) {
   slam.load_map(file);
   const auto keyframes = slam.stats().keyframes;
   EXPECT_GT(keyframes, 0u);
-  int tracked = 0;
-  for (std::size_t i = 0; i < seq.size(); i += 3) {  // every third frame: not the mapping run's input
+  // Every third frame: not the mapping run's input. The first is relocalized in the map, and the
+  // frames recover from it until it is confirmed (EuRoC preset: 5 frames); from then on
+  // every frame is localized, a trusted pose.
+  std::vector<FrameState> states;
+  for (std::size_t i = 0; i < seq.size(); i += 3) {
     const auto im = seq.frame(i);
-    tracked += slam.track(im.left, im.right, im.timestamp).tracked ? 1 : 0;
+    const auto f = slam.track(im.left, im.right, im.timestamp);
+    EXPECT_EQ(f.tracked, f.frame_state == FrameState::kLocalized) << i;
+    states.push_back(f.frame_state);
   }
-  EXPECT_EQ(tracked, 20);
+  ASSERT_EQ(states.size(), 20u);
+  const auto first = std::find(states.begin(), states.end(), FrameState::kLocalized) - states.begin();
+  EXPECT_GE(first, 4);
+  EXPECT_LE(first, 9);
+  for (long i = 0; i < 20; ++i) {
+    EXPECT_EQ(states[static_cast<std::size_t>(i)], i < first ? FrameState::kRecovering : FrameState::kLocalized) << i;
+  }
+  EXPECT_STREQ(to_string(FrameState::kRecovering), "recovering");
   EXPECT_EQ(slam.stats().keyframes, keyframes);  // localization adds nothing
   EXPECT_THROW(slam.load_map(file), std::logic_error);  // only before the first frame
 }

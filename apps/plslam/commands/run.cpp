@@ -41,8 +41,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Exit code of a run in which tracking never started a map (README: exit codes).
-constexpr int kExitNotInitialized = 3;
+// Exit code of a run that went to its end but whose result is not usable: tracking never started
+// a map, or a --localize run localized under --min-localized of its frames (README: exit codes).
+constexpr int kExitNotUsable = 3;
 
 
 // Marks a run stopped by a signal (README: stats.json); "complete" already says it did not finish.
@@ -66,6 +67,7 @@ struct RunArgs {
   std::string save_map;  // --save-map FILE
   std::string load_map;  // --load-map FILE
   bool localize = false; // --localize
+  double min_localized = 0.5;  // --min-localized: share of the frames a --localize run must localize
   std::string video;         // --video FILE: side-by-side stereo video
   std::string camera;        // --camera DEVICE: live V4L2 camera (side by side, or the left one)
   std::string camera_right;  // --camera-right DEVICE
@@ -199,6 +201,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   }
   nlohmann::json map_stats = {{"loaded", args.load_map.empty() ? nlohmann::json(nullptr) : nlohmann::json(args.load_map)},
                                {"localization_only", args.localize},
+                               {"min_localized", args.localize ? nlohmann::json(args.min_localized) : nlohmann::json(nullptr)},
                                {"saved", nullptr}};
   if (loaded) {
     gt_anchor = loaded->meta.T_gt_map;
@@ -389,7 +392,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
           "no trajectory written\n",
           input.name, report.frames, options.tracker.init_min_points);
     }
-    return kExitNotInitialized;
+    return kExitNotUsable;
   }
 
   const auto traj = slam.tracked_trajectory();
@@ -449,8 +452,18 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   io::write_file_atomically(out_dir / "stats.json", [&](std::ostream& o) { o << stats.dump(2) << "\n"; });
   stats_out = stats;
   // A signal while the viewer lingers on a finished run does not make the run interrupted.
-  const int rc = app::stop_requested() ? app::stop_exit_code() : 0;
+  int rc = app::stop_requested() ? app::stop_exit_code() : 0;
   std::cout << report.summary(slam);
+  if (rc == 0 && args.localize && fatal.empty()) {
+    const std::size_t localized = report.count(tracking::FrameState::kLocalized);
+    const double share = report.frames ? static_cast<double>(localized) / static_cast<double>(report.frames) : 0.0;
+    if (share < args.min_localized) {
+      std::cerr << fmt::format("plslam: error: {}: localized {} of {} frames ({:.0f} %) in the map {}, under "
+                               "--min-localized {}; the outputs are written, but the result is not usable\n",
+                               input.name, localized, report.frames, 100.0 * share, args.load_map, args.min_localized);
+      rc = kExitNotUsable;
+    }
+  }
   spdlog::info("outputs written to {}", out_dir.string());
   if (viewer) {
     // The page ends on exactly what `plslam view` shows of these outputs.
@@ -544,9 +557,21 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                                           "Save the map at the end (after loop closing) to FILE (.plmap)");
                            auto* load = sub.add_option("--load-map", args->load_map,
                                                        "Start in the map of FILE: relocalize in it, then keep mapping it");
-                           sub.add_flag("--localize", args->localize,
+                           auto* localize = sub.add_flag("--localize", args->localize,
                                         "With --load-map: localization only (no new keyframes, points or lines)")
                                ->needs(load);
+                           sub.add_option("--min-localized", args->min_localized,
+                                          "With --localize: exit 3 (outputs still written) when under this share of "
+                                          "the frames is localized")
+                               ->check(CLI::Range(0.0, 1.0))
+                               ->capture_default_str()
+                               ->needs(localize);
+                           sub.footer(
+                               "Exit codes: 0 done; 2 bad usage or input (one line naming the file); 3 ran to the end "
+                               "but the result is not usable (no map was ever started, or --localize localized under "
+                               "--min-localized of the frames; the outputs are still written); 128 + N stopped by "
+                               "signal N (the outputs so far are written); 1 internal error. trajectory.tum holds only "
+                               "the poses plslam stands behind (frames.csv state tracked, relocalized or localized).");
                            sub.add_option("--repeat", args->repeat,
                                           "Run N times into DIR/run-1..N and report the ATE's median, min and max")
                                ->check(CLI::Range(1, 1000))

@@ -13,7 +13,7 @@ InputAlignedTrajectory align_to_input(const std::vector<tracking::FrameRecord>& 
     if (rec.frame_id < 0 || static_cast<std::size_t>(rec.frame_id) >= timestamps.size()) {
       throw std::logic_error("align_to_input: frame id outside the input");
     }
-    if (!rec.tracked) continue;
+    if (!rec.trusted()) continue;
     tracked[static_cast<std::size_t>(rec.frame_id)] = tracking::Tracker::pose_of(rec).inverse().isometry();
     any = true;
   }

@@ -31,7 +31,17 @@ const char* to_string(TrackingState state) {
   return "?";
 }
 
+const char* to_string(FrameState state) {
+  return tracking::to_string(static_cast<tracking::FrameState>(state));
+}
+
 namespace {
+
+static_assert(static_cast<int>(FrameState::kLocalized) == static_cast<int>(tracking::FrameState::kLocalized) &&
+                  static_cast<int>(FrameState::kRecovering) == static_cast<int>(tracking::FrameState::kRecovering) &&
+                  static_cast<int>(FrameState::kRelocalized) == static_cast<int>(tracking::FrameState::kRelocalized) &&
+                  static_cast<int>(FrameState::kTracked) == static_cast<int>(tracking::FrameState::kTracked),
+              "the public FrameState mirrors tracking::FrameState");
 
 TrackingState public_state(tracking::TrackingState s) {
   switch (s) {
@@ -174,6 +184,7 @@ TrackedFrame Slam::track(const cv::Mat& left, const cv::Mat& right, double times
   out.index = r.frame_id;
   out.timestamp = r.timestamp;
   out.state = public_state(r.track.state);
+  out.frame_state = static_cast<FrameState>(r.track.frame_state);
   out.tracked = r.track.tracked;
   if (r.track.tracked) {
     // The frame's record: its pose relative to its reference keyframe, which is where the

@@ -63,13 +63,14 @@ void RunReport::add(const FrameResult& r) {
   const auto& d = r.track.decision;
   frame_rows.push_back(fmt::format(
       "{},{:.9f},{},{},{},{},{},{},{},{:.2f},{:.2f},{:.3f},{},{},{},{},{},{},{},{:.3f},{},{},{},{:.1f}", r.frame_id, r.timestamp,
-      tracking::to_string(r.track.state), r.track.tracked ? 1 : 0, r.track.keyframe ? 1 : 0,
+      tracking::to_string(r.track.frame_state), r.track.tracked ? 1 : 0, r.track.keyframe ? 1 : 0,
       r.track.keyframe ? (r.track.decision.insert ? tracking::to_string(d.reason) : "new-map") : "", r.track.point_inliers, r.track.line_inliers,
       in.reference_tracked, d.threshold, d.delta_pid, d.speed, in.tracked_close, in.untracked_close,
       r.track.local_keyframes, r.track.local_points, r.track.local_lines, r.extraction.stereo_points,
       r.extraction.stereo_lines, r.tracking_ms, r.map_size.keyframes, r.map_size.points, r.map_size.lines, r.rss_mb));
   ++frames;
   if (r.track.tracked) ++tracked_frames;
+  ++state_counts[static_cast<std::size_t>(r.track.frame_state)];
   tracking_ms.push_back(r.tracking_ms);
   extraction_ms.push_back(r.extraction.extraction_ms);
   stereo_ms.push_back(r.extraction.stereo_ms);
@@ -118,11 +119,14 @@ nlohmann::json RunReport::to_json(const System& slam) const {
           {"frames", frames},
           {"initialized_at_frame", init ? nlohmann::json(*init) : nlohmann::json(nullptr)},
           {"tracked_frames", tracked_frames},
+          {"frame_states", states_json()},
           {"frames_before_initialization", before_init},
           {"lost_frames", lost_ids.size()},
           {"lost_frame_ids", lost_ids},
           {"relocalizations",
-           {{"count", slam.tracker().relocalized_frames().size()}, {"frames", slam.tracker().relocalized_frames()}}},
+           {{"count", slam.tracker().relocalized_frames().size()},
+            {"frames", slam.tracker().relocalized_frames()},
+            {"refuted", slam.tracker().refuted_relocalizations()}}},
           {"new_map_segments",
            {{"count", slam.tracker().new_segment_frames().size()}, {"frames", slam.tracker().new_segment_frames()}}},
           {"place_recognition",
@@ -172,15 +176,29 @@ nlohmann::json RunReport::to_json(const System& slam) const {
           {"triangulated_points", ms.triangulated_points}};
 }
 
+nlohmann::json RunReport::states_json() const {
+  nlohmann::json j = nlohmann::json::object();
+  for (std::size_t i = 0; i < state_counts.size(); ++i) {
+    j[tracking::to_string(static_cast<tracking::FrameState>(i))] = state_counts[i];
+  }
+  return j;
+}
+
+std::size_t RunReport::count(tracking::FrameState s) const { return state_counts[static_cast<std::size_t>(s)]; }
+
 std::string RunReport::summary(const System& slam) const {
+  using tracking::FrameState;
   return fmt::format(
       "frames {} (tracked {}, skipped {}), lost events {}, relocalizations {}, new map segments {}, loops {}, "
       "keyframes {}, map points {}, map lines {}\n"
+      "frame states: tracked {}, relocalized {}, localized {}, recovering {}, lost {}\n"
       "tracking ms/frame: median {:.1f}, mean {:.1f}, p90 {:.1f}\n",
       frames, tracked_frames, skipped.size(), slam.tracker().lost_events(), slam.tracker().relocalized_frames().size(),
       slam.tracker().new_segment_frames().size(), slam.loop_closer() ? slam.loop_closer()->stats().loops.size() : 0,
       slam.map().num_keyframes(), slam.map().num_points(),
-      slam.map().num_lines(), percentile(tracking_ms, 0.5), mean(tracking_ms), percentile(tracking_ms, 0.9));
+      slam.map().num_lines(), count(FrameState::kTracked), count(FrameState::kRelocalized),
+      count(FrameState::kLocalized), count(FrameState::kRecovering), count(FrameState::kLost),
+      percentile(tracking_ms, 0.5), mean(tracking_ms), percentile(tracking_ms, 0.9));
 }
 
 nlohmann::json realtime_json(const std::vector<double>& lag_ms, double fps) {

@@ -1,6 +1,7 @@
 #pragma once
 // What `plslam run` reports: per-frame timings and counts gathered during the run, turned into
 // stats.json and a short summary; and the accuracy against the dataset's ground truth.
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,7 +17,9 @@ namespace plslam::system {
 struct RunReport {
   std::vector<double> tracking_ms, extraction_ms, stereo_ms, track_motion_ms, track_local_map_ms,
       pose_optimization_ms;
-  std::size_t frames = 0, tracked_frames = 0;
+  std::size_t frames = 0;
+  std::size_t tracked_frames = 0;  // frames with a trusted pose (tracking::is_trusted)
+  std::array<std::size_t, 5> state_counts{};  // frames per tracking::FrameState
   std::size_t input_frames = 0;            // frames the input holds (the selected range)
   std::vector<io::SkippedFrame> skipped;   // unreadable or blank frames, left out
   std::vector<std::size_t> untracked_lines;  // input frames whose trajectory.kitti line is not tracked
@@ -32,6 +35,8 @@ struct RunReport {
   // tracker's records), timings, and the map's size.
   nlohmann::json to_json(const System& slam) const;
   std::string summary(const System& slam) const;
+  std::size_t count(tracking::FrameState s) const;
+  nlohmann::json states_json() const;  // {"lost": n, "recovering": n, ...}
 };
 
 // `plslam run --realtime`: how far behind real time the run fell. lag_ms holds, per frame, how

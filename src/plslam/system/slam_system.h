@@ -76,8 +76,9 @@ class System {
   // are filled in here.
   MapContents capture_map(MapFileMeta meta) const;
 
-  // The tracked frames only (never a prediction made while lost or before initialisation),
-  // T_world_leftcam with world = the first keyframe's camera.
+  // The trusted frames only (tracking::is_trusted: never a prediction made while lost or before
+  // initialisation, nor a pose recovering from an unconfirmed relocalization), T_world_leftcam with
+  // world = the first keyframe's camera.
   Trajectory tracked_trajectory() const;
   // The id of the first frame that started a map; nullopt while none has.
   std::optional<long> initialized_at() const;

@@ -65,6 +65,37 @@ int count_visible_points(const Frame& f, const std::vector<map::MapPoint*>& poin
   return n;
 }
 
+CellCoverage cell_coverage(const Frame& f, const std::vector<map::MapPoint*>& points, int cols, int rows,
+                           int min_points) {
+  const auto& d = *f.data;
+  const geometry::StereoCamera cam(d.calib);
+  const Eigen::Vector3d Ow = f.T_cw.inverse().translation();
+  core::PointerSet inliers;
+  inliers.clear(f.points.size());
+  for (std::size_t i = 0; i < f.points.size(); ++i) {
+    if (f.points[i] && !f.point_outlier[i]) inliers.insert(f.points[i]);
+  }
+  const auto cells = static_cast<std::size_t>(cols * rows);
+  std::vector<int> visible(cells, 0), matched(cells, 0);
+  for (const map::MapPoint* mp : points) {
+    if (!mp || mp->is_bad()) continue;
+    const auto v = visibility(*mp, f.T_cw, Ow, cam);
+    if (!v) continue;
+    const int c = std::clamp(static_cast<int>(v->uv.x() * cols / d.calib.width), 0, cols - 1);
+    const int r = std::clamp(static_cast<int>(v->uv.y() * rows / d.calib.height), 0, rows - 1);
+    const auto k = static_cast<std::size_t>(r * cols + c);
+    ++visible[k];
+    if (inliers.contains(mp)) ++matched[k];
+  }
+  CellCoverage out;
+  for (std::size_t k = 0; k < cells; ++k) {
+    if (visible[k] < min_points) continue;
+    ++out.predicted;
+    out.covered += matched[k] > 0;
+  }
+  return out;
+}
+
 int search_points_from_frame(Frame& cur, const Frame& last, double radius, const SearchOptions& o) {
   const auto& d = *cur.data;
   const geometry::StereoCamera cam(d.calib);

@@ -28,6 +28,19 @@ int search_points_in_local_map(Frame& cur, const std::vector<map::MapPoint*>& ca
 // scale range, less than 60 degrees off their mean viewing direction), matched or not.
 int count_visible_points(const Frame& f, const std::vector<map::MapPoint*>& points);
 
+// Where in the image the frame's inliers explain the map: the image is cut into `cols` x `rows`
+// cells; `predicted` counts the cells where at least `min_points` of `points` are visible from the
+// frame's pose, `covered` those of them holding at least one of the frame's inlier matches. A true
+// place is matched all over the part of the image the map covers; a look-alike only where the
+// repeated object is, while the map's surroundings, visible from the same pose, find nothing.
+struct CellCoverage {
+  int predicted = 0;
+  int covered = 0;
+  double share() const { return predicted > 0 ? static_cast<double>(covered) / predicted : 0.0; }
+};
+CellCoverage cell_coverage(const Frame& f, const std::vector<map::MapPoint*>& points, int cols = 8, int rows = 6,
+                           int min_points = 5);
+
 // Matches map lines projected with cur.T_cw: a candidate frame line must be nearly parallel to the
 // projected segment, lie within `radius` pixels of it (both endpoints' distances to the candidate
 // line) and overlap it; the smallest LBD distance under the threshold wins.

@@ -31,6 +31,17 @@ const char* to_string(TrackingState s) {
   return "?";
 }
 
+const char* to_string(FrameState s) {
+  switch (s) {
+    case FrameState::kLost: return "lost";
+    case FrameState::kRecovering: return "recovering";
+    case FrameState::kRelocalized: return "relocalized";
+    case FrameState::kTracked: return "tracked";
+    case FrameState::kLocalized: return "localized";
+  }
+  return "?";
+}
+
 Tracker::Tracker(map::Map& map, TrackerOptions options, std::function<void(map::KeyFrame*)> insert_keyframe,
                  std::function<bool()> mapping_idle)
     : map_(map),
@@ -115,6 +126,31 @@ bool Tracker::check_motion(const Frame& f) {
   return true;
 }
 
+bool Tracker::beyond_reach(const Frame& f) const {
+  const auto& o = options_.relocalization;
+  if (velocity_ || o.max_speed <= 0 || !last_ || records_.empty() || !records_.back().tracked) return false;
+  const double dt = std::max(0.0, f.data->timestamp - last_->data->timestamp);
+  const double moved = (f.camera_center() - last_->camera_center()).norm();
+  const double reach = o.max_speed * dt + options_.jump_deviation_m;
+  if (moved <= reach) return false;
+  spdlog::warn("frame {}: the tracked pose is {:.2f} m from the last one, {:.2f} s earlier: further than a camera "
+               "moves (relocalization.max_speed {} m/s)",
+               f.id(), moved, dt, o.max_speed);
+  return true;
+}
+
+bool Tracker::recovery_holds(const Frame& f, bool jumped) const {
+  if (jumped) return false;
+  const auto e = explained(f, local_points_);
+  const double min_coverage = options_.relocalization.min_cell_coverage;
+  const auto coverage = min_coverage > 0 ? cell_coverage(f, local_points_) : CellCoverage{};
+  spdlog::debug("frame {}: recovering ({} of {} frames): {} of {} visible local map points matched, inliers in {} "
+                "of {} cells",
+                f.id(), recovery_->frames + 1, options_.relocalization.confirm_frames, e.matched, e.visible,
+                coverage.covered, coverage.predicted);
+  return e.enough && (min_coverage <= 0 || coverage.share() >= min_coverage);
+}
+
 Tracker::Explained Tracker::explained(const Frame& f, const std::vector<map::MapPoint*>& points) const {
   Explained e;
   e.matched = f.num_matched_points();
@@ -164,26 +200,57 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     }
   } else {
     bool tracked = false;
-    if (velocity_) tracked = track_with_motion_model(f, result.times);
+    // While recovering, the frame right after the relocalization has no velocity: its matches are
+    // searched around the last pose (the motion model's wide retry covers the motion), which on a
+    // reversed path keeps many more than matching the reference keyframe's descriptors.
+    if (velocity_ || recovery_) tracked = track_with_motion_model(f, result.times);
     if (!tracked) tracked = track_reference_keyframe(f, result.times);
     if (tracked) {
       tracked = track_local_map(f, result.times, result.point_inliers, result.line_inliers);
     }
-    // A pose far from the prediction that explains little of what the map shows there is a
-    // look-alike place (after a black-out the motion model is a second or more out of date).
-    if (tracked && velocity_ && check_motion(f)) {
+    bool jumped = false;
+    if (tracked && beyond_reach(f)) {
+      // No velocity to predict with (the frame after a relocalization or a new map), and a move no
+      // camera makes in the time: a pose on another place, never kept.
+      suspect_jumps_.push_back({f.id(), (f.camera_center() - last_->camera_center()).norm(), 0.0});
+      tracked = false;
+    } else if (tracked && velocity_ && check_motion(f)) {
+      // A pose far from the prediction that explains little of what the map shows there is a
+      // look-alike place (after a black-out the motion model is a second or more out of date).
+      jumped = true;
       const auto e = explained(f, local_points_);
       spdlog::log(e.enough ? spdlog::level::info : spdlog::level::warn,
                   "frame {}: {} of the {} local map points visible from the jumped pose matched: {}", f.id(), e.matched,
                   e.visible, e.enough ? "kept" : "a look-alike place, relocalizing");
       tracked = e.enough;
     }
+    // Tracked across a gap (a black-out, unreadable frames): the motion model is stale, and a
+    // look-alike where it points would be tracked as if the camera had not been moved. The pose
+    // recovers like a relocalization's, this frame checked too.
+    const double gap = f.data->timestamp - last_->data->timestamp;
+    if (tracked && !recovery_ && options_.recover_after_gap_s > 0 && gap > options_.recover_after_gap_s) {
+      spdlog::info("frame {}: tracked after a {:.2f} s gap, recovering until confirmed", f.id(), gap);
+      recovery_ = Recovery{f.id(), 0, f.T_cw, true};
+      trusted_since_recovery_ = false;
+    }
+    if (tracked && recovery_ && !recovery_holds(f, jumped)) {
+      spdlog::warn("frame {}: the {} of frame {} is refuted after {} frames", f.id(),
+                   recovery_->after_gap ? "tracking after the gap" : "relocalization", recovery_->since_frame,
+                   recovery_->frames);
+      if (!recovery_->after_gap) refuted_relocalizations_.push_back(recovery_->since_frame);
+      tracked = false;
+    }
     if (tracked) {
       ok = true;
       velocity_ = (f.T_cw * last_->T_cw.inverse()).normalized();
       velocity_dt_ = f.data->timestamp - last_->data->timestamp;
+      if (recovery_) {
+        ++recovery_->frames;
+        if (recovery_confirmed(f)) confirm_relocalization(f, result);
+      }
       finish_tracked_frame(f, result);
     } else {
+      recovery_.reset();
       ++lost_events_;
       const bool relocalizing = relocalization_on();
       spdlog::warn("frame {}: tracking lost (event {}), {}", f.id(), lost_events_,
@@ -203,16 +270,31 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   }
 
   if (!f.reference) f.reference = reference_;
+  FrameState fs = FrameState::kLost;
+  if (ok) {
+    if (recovery_) {
+      fs = FrameState::kRecovering;
+    } else if (options_.localization_only) {
+      fs = FrameState::kLocalized;
+    } else {
+      fs = result.relocalized ? FrameState::kRelocalized : FrameState::kTracked;
+    }
+  }
   FrameRecord rec;
   rec.frame_id = f.id();
   rec.timestamp = f.data->timestamp;
   rec.reference = f.reference;
   rec.T_cr = f.reference ? f.T_cw * f.reference->pose_inverse() : f.T_cw;
   rec.tracked = ok;
+  rec.state = fs;
   records_.push_back(rec);
-  if (ok) last_tracked_record_ = records_.size() - 1;
+  if (rec.trusted()) {
+    last_tracked_record_ = records_.size() - 1;
+    trusted_since_recovery_ = true;
+  }
   result.state = state_;
-  result.tracked = ok;
+  result.frame_state = fs;
+  result.tracked = rec.trusted();
   last_ = std::move(f);
   return result;
 }
@@ -224,16 +306,54 @@ bool Tracker::relocalize_and_track(Frame& f, TrackResult& result) {
     return false;
   }
   state_ = TrackingState::kOk;
-  result.relocalized = true;
   result.relocalized_against = against;
-  relocalized_frames_.push_back(f.id());
   lost_since_.reset();
+  const bool continues = continues_trusted_motion(f);
   // The frames since the loss carry predictions, not poses: no velocity across them.
   velocity_.reset();
-  spdlog::info("frame {}: relocalized against keyframe {} ({} point and {} line inliers)", f.id(), against,
-               result.point_inliers, result.line_inliers);
+  spdlog::info("frame {}: relocalized against keyframe {} ({} point and {} line inliers){}", f.id(), against,
+               result.point_inliers, result.line_inliers,
+               continues ? ", where the motion before the loss puts it"
+                         : (options_.relocalization.confirm_frames > 1 ? ", recovering until confirmed" : ""));
+  recovery_ = Recovery{f.id(), 1, f.T_cw};
+  trusted_since_recovery_ = false;
+  if (continues || recovery_confirmed(f)) confirm_relocalization(f, result);
   finish_tracked_frame(f, result);
   return true;
+}
+
+bool Tracker::continues_trusted_motion(const Frame& f) const {
+  const auto& o = options_.relocalization;
+  if (o.continuity_s <= 0 || !velocity_ || !last_ || !last_tracked_record_ || !trusted_since_recovery_) return false;
+  if (f.data->timestamp - records_[*last_tracked_record_].timestamp > o.continuity_s) return false;
+  // The frames since the trusted one are lost: last_ carries the motion model's chained prediction.
+  const geometry::SE3 predicted = predicted_pose(f);
+  const double m = (f.camera_center() - predicted.inverse().translation()).norm();
+  const double deg = geometry::so3_log(f.T_cw.rotation() * predicted.rotation().transpose()).norm() * 180.0 / std::numbers::pi;
+  return m <= options_.jump_deviation_m && deg <= options_.jump_deviation_deg;
+}
+
+bool Tracker::recovery_confirmed(const Frame& f) const {
+  const auto& o = options_.relocalization;
+  if (recovery_->frames < o.confirm_frames) return false;
+  if (o.confirm_distance_m <= 0 && o.confirm_angle_deg <= 0) return true;
+  const double moved = (f.camera_center() - recovery_->T_cw.inverse().translation()).norm();
+  const double turned =
+      geometry::so3_log(f.T_cw.rotation() * recovery_->T_cw.rotation().transpose()).norm() * 180.0 / std::numbers::pi;
+  return (o.confirm_distance_m > 0 && moved >= o.confirm_distance_m) ||
+         (o.confirm_angle_deg > 0 && turned >= o.confirm_angle_deg);
+}
+
+void Tracker::confirm_relocalization(const Frame& f, TrackResult& result) {
+  if (!recovery_->after_gap) {
+    result.relocalized = true;
+    relocalized_frames_.push_back(recovery_->since_frame);
+  }
+  if (recovery_->since_frame != f.id()) {
+    spdlog::info("frame {}: the {} of frame {} is confirmed", f.id(),
+                 recovery_->after_gap ? "tracking after the gap" : "relocalization", recovery_->since_frame);
+  }
+  recovery_.reset();
 }
 
 void Tracker::finish_tracked_frame(Frame& f, TrackResult& result) {
@@ -244,7 +364,8 @@ void Tracker::finish_tracked_frame(Frame& f, TrackResult& result) {
   result.local_keyframes = static_cast<int>(local_keyframes_.size());
   result.local_points = static_cast<int>(local_points_.size());
   result.local_lines = static_cast<int>(local_lines_.size());
-  if (result.decision.insert && !options_.localization_only) {
+  // No keyframe from an unconfirmed relocalization: a look-alike place must not grow the map.
+  if (result.decision.insert && !options_.localization_only && !recovery_) {
     create_keyframe(f);
     policy_.keyframe_inserted(inputs);
     result.keyframe = true;

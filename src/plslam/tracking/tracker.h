@@ -46,6 +46,26 @@ struct RelocalizationOptions {
   // first tracked frame (a loaded map) there is no gate: the camera may be anywhere.
   double max_speed = 0;     // m/s
   double gate_margin = 1.0; // m
+  // A relocalization is trusted only after this many frames in a row, the relocalizing one
+  // included, were tracked from it, each matching at least min_found_ratio of the local map points
+  // visible from its pose and moving as the motion model (or max_speed) allows, and once the
+  // camera has moved confirm_distance_m or turned confirm_angle_deg from the relocalized pose (0
+  // and 0: no such condition). Until then the frames are `recovering`: their poses are not
+  // reported as trusted and no keyframe is made. A look-alike place (a shelf with the same books
+  // on its other face) can pass every check of one frame, but its repeated part leaves the view as
+  // the camera moves on. 1: trusted at once.
+  int confirm_frames = 1;
+  double confirm_distance_m = 0;
+  double confirm_angle_deg = 0;
+  // ... and every recovering frame has inliers in at least this share of the image cells where
+  // the local map shows points (tracking::cell_coverage): a look-alike is matched only on the
+  // repeated object. 0: no such check.
+  double min_cell_coverage = 0;
+  // A relocalization within this many seconds of the last trusted frame, with only lost frames
+  // between them, whose pose lies within tracking.jump_deviation_m/_deg of where the motion model
+  // carries that frame, continues the trusted trajectory: it is confirmed at once. A look-alike
+  // place metres away never lands on the prediction. 0: never.
+  double continuity_s = 0;
 };
 
 struct TrackerOptions {
@@ -77,6 +97,10 @@ struct TrackerOptions {
   // sequential): 0.15 m and 1.3 deg (a car on the street loop); a look-alike corner once gave 1 m
   // and 12 deg.
   double jump_deviation_m = 0.5;
+  // A frame tracked more than this many seconds after the frame before it (a black-out, frames
+  // skipped as unreadable) is not trusted at once: it recovers as a relocalization does
+  // (RelocalizationOptions::confirm_frames and its checks). 0: never.
+  double recover_after_gap_s = 0;
   double jump_deviation_deg = 10.0;
   int min_motion_matches = 20;
   int min_pose_inliers = 10;
@@ -104,6 +128,17 @@ struct TrackerOptions {
 enum class TrackingState { kNotInitialized, kOk, kLost };
 const char* to_string(TrackingState s);
 
+// What a frame's pose is worth (frames.csv `state`, the API's frame_state):
+//   tracked      tracked from the frames before it (or it started a map): trusted;
+//   recovering   tracked from a relocalization not yet confirmed: a pose, but not trusted;
+//   relocalized  the frame that confirmed a relocalization: trusted;
+//   localized    tracked in a loaded map, localization only (--localize): trusted;
+//   lost         no pose (lost, or before the map started).
+enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized };
+const char* to_string(FrameState s);
+// The states whose pose plslam stands behind (trajectory.tum holds only these).
+constexpr bool is_trusted(FrameState s) { return s != FrameState::kLost && s != FrameState::kRecovering; }
+
 struct TrackStageTimes {
   double track_motion_ms = 0;     // motion model or reference keyframe, search + optimisation
   double track_local_map_ms = 0;  // local map search + optimisation
@@ -112,13 +147,16 @@ struct TrackStageTimes {
 
 struct TrackResult {
   TrackingState state = TrackingState::kNotInitialized;
-  bool tracked = false;  // the frame has a tracked pose (initialised a map or was tracked in one)
+  FrameState frame_state = FrameState::kLost;
+  // The frame has a trusted pose (is_trusted(frame_state)): it initialised a map or was tracked
+  // in one, and is not recovering from an unconfirmed relocalization.
+  bool tracked = false;
   int point_inliers = 0;
   int line_inliers = 0;
   bool keyframe = false;
-  bool relocalized = false;      // tracked again in the same map after being lost
+  bool relocalized = false;      // confirmed a relocalization (FrameState::kRelocalized)
   bool new_map_segment = false;  // a lost camera started a new, disconnected map segment
-  long relocalized_against = -1; // the keyframe (id) relocalization matched
+  long relocalized_against = -1; // the keyframe (id) relocalization matched (on the relocalizing frame)
   KeyframeDecision decision;
   KeyframeInputs keyframe_inputs;  // what the decision saw (tracked frames only)
   int local_keyframes = 0, local_points = 0, local_lines = 0;  // the local map tracked against
@@ -140,7 +178,9 @@ struct FrameRecord {
   double timestamp = 0;
   map::KeyFrame* reference = nullptr;
   geometry::SE3 T_cr;
-  bool tracked = false;
+  bool tracked = false;  // has a pose estimate (trusted or recovering)
+  FrameState state = FrameState::kLost;
+  bool trusted() const { return is_trusted(state); }
 };
 
 class Tracker {
@@ -172,7 +212,10 @@ class Tracker {
   // Forgets the culled points and lines it keeps between frames (the last frame's matches, the
   // local map), so that Map::reclaim() can free them; call between frames.
   void drop_bad_landmarks();
+  // Confirmed relocalizations, by the frame that relocalized (RelocalizationOptions::confirm_frames).
   const std::vector<long>& relocalized_frames() const { return relocalized_frames_; }
+  // Relocalizations that a later frame refuted before confirmation: the frames that relocalized.
+  const std::vector<long>& refuted_relocalizations() const { return refuted_relocalizations_; }
   const std::vector<long>& new_segment_frames() const { return new_segment_frames_; }
   const std::vector<FrameRecord>& records() const { return records_; }
   // The ids of the local map the last frame was tracked against (the live viewer highlights it);
@@ -207,7 +250,9 @@ class Tracker {
   // the candidate keyframe becomes the reference. Defined in tracker_relocalization.cpp.
   bool relocalize(Frame& f, TrackStageTimes& t, long& keyframe_id);
   // Relocalization, then local map tracking and the keyframe decision; true when both succeed.
+  // The frame then recovers (recovery_) until confirm_relocalization().
   bool relocalize_and_track(Frame& f, TrackResult& result);
+  void confirm_relocalization(const Frame& f, TrackResult& result);
   // While lost: whether this frame should start a new map segment instead of waiting for
   // relocalization.
   bool should_start_new_segment(const Frame& f);
@@ -230,6 +275,12 @@ class Tracker {
   // Compares the tracked pose of `f` with the prediction (call before the velocity is updated);
   // true for a suspect jump.
   bool check_motion(const Frame& f);
+  // Without a velocity (the frame after a relocalization or a new map): whether `f` lies further
+  // from the last tracked pose than a camera at relocalization.max_speed can have moved.
+  bool beyond_reach(const Frame& f) const;
+  // A recovering frame (tracked from an unconfirmed relocalization): whether it still matches
+  // enough of the local map; false refutes the relocalization.
+  bool recovery_holds(const Frame& f, bool jumped) const;
   // How many of `points` are visible from the pose of `f`, how many map points `f` matched, and
   // whether those are at least relocalization.min_found_ratio of them: a true place explains a
   // good share of what the map shows there, a look-alike only what repeats.
@@ -257,7 +308,21 @@ class Tracker {
   std::vector<map::MapLine*> local_lines_;
   core::PointerSet seen_points_, seen_lines_;  // update_local_map's deduplication
   std::vector<FrameRecord> records_;
-  std::optional<std::size_t> last_tracked_record_;  // index into records_
+  std::optional<std::size_t> last_tracked_record_;  // index into records_, the last trusted one
+  // An unconfirmed relocalization: the frame that relocalized and the frames tracked from it so far.
+  struct Recovery {
+    long since_frame = 0;
+    int frames = 0;
+    geometry::SE3 T_cw;  // the relocalized pose
+    bool after_gap = false;  // started by tracking across a gap, not by a relocalization
+  };
+  // Whether the recovery has seen enough (RelocalizationOptions::confirm_*) with `f` tracked.
+  bool recovery_confirmed(const Frame& f) const;
+  std::optional<Recovery> recovery_;
+  bool trusted_since_recovery_ = false;  // no recovery started since the last trusted frame
+  // Whether `f`, just relocalized, continues the trusted trajectory (continuity_s).
+  bool continues_trusted_motion(const Frame& f) const;
+  std::vector<long> refuted_relocalizations_;
   long seen_big_changes_ = 0;  // map_.big_changes() when the last frame was tracked
   int lost_events_ = 0;
   int motion_wide_retries_ = 0;
