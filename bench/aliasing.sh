@@ -93,8 +93,8 @@ fi
 
 if [[ ,$cases, == *,kidnap,* ]]; then
   render street2 --scene street --preset kitti --format kitti --frames 600 --loop --seed 2
-  render corridor --scene corridor --preset euroc --frames 400 --seed 1
-  for scene in street2:9:400 corridor:5.5:300; do
+  render corridor --scene corridor --preset euroc --frames 600 --seed 1
+  for scene in street2:9:400 corridor:5.5:500; do
     IFS=: read -r name period vanish <<< "$scene"
     for k in 1 2 3; do
       back=$(python3 "$lib" back "$out/seq/$name" "$vanish" "$(python3 -c "print($k * $period)")")
