@@ -20,6 +20,16 @@ namespace plslam::tracking {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// How far apart two camera poses are: camera centres in metres, rotation in degrees.
+struct PoseGap {
+  double m = 0;
+  double deg = 0;
+};
+PoseGap pose_gap(const geometry::SE3& T_aw, const geometry::SE3& T_bw) {
+  return {(T_aw.inverse().translation() - T_bw.inverse().translation()).norm(),
+          geometry::so3_log(T_aw.rotation() * T_bw.rotation().transpose()).norm() * 180.0 / std::numbers::pi};
+}
 }  // namespace
 
 const char* to_string(TrackingState s) {
@@ -111,9 +121,7 @@ geometry::SE3 Tracker::Anchor::T_cw() const { return keyframe ? T_ck * keyframe-
 geometry::SE3 Tracker::pose_of(const FrameRecord& r) { return anchor_of(r).T_cw(); }
 
 bool Tracker::check_motion(const Frame& f) {
-  const geometry::SE3 predicted = predicted_pose(f);
-  const double m = (f.T_cw.inverse().translation() - predicted.inverse().translation()).norm();
-  const double deg = geometry::so3_log(f.T_cw.rotation() * predicted.rotation().transpose()).norm() * 180.0 / std::numbers::pi;
+  const auto [m, deg] = pose_gap(f.T_cw, predicted_pose(f));
   motion_deviation_m_.push_back(m);
   motion_deviation_deg_.push_back(deg);
   const bool far = options_.jump_deviation_m > 0 && m > options_.jump_deviation_m;
@@ -126,13 +134,14 @@ bool Tracker::check_motion(const Frame& f) {
   return true;
 }
 
-bool Tracker::beyond_reach(const Frame& f) const {
+bool Tracker::beyond_reach(const Frame& f) {
   const auto& o = options_.relocalization;
   if (velocity_ || o.max_speed <= 0 || !last_ || records_.empty() || !records_.back().tracked) return false;
   const double dt = std::max(0.0, f.data->timestamp - last_->data->timestamp);
   const double moved = (f.camera_center() - last_->camera_center()).norm();
   const double reach = o.max_speed * dt + options_.jump_deviation_m;
   if (moved <= reach) return false;
+  suspect_jumps_.push_back({f.id(), moved, 0.0});
   spdlog::warn("frame {}: the tracked pose is {:.2f} m from the last one, {:.2f} s earlier: further than a camera "
                "moves (relocalization.max_speed {} m/s)",
                f.id(), moved, dt, o.max_speed);
@@ -212,7 +221,6 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     if (tracked && beyond_reach(f)) {
       // No velocity to predict with (the frame after a relocalization or a new map), and a move no
       // camera makes in the time: a pose on another place, never kept.
-      suspect_jumps_.push_back({f.id(), (f.camera_center() - last_->camera_center()).norm(), 0.0});
       tracked = false;
     } else if (tracked && velocity_ && check_motion(f)) {
       // A pose far from the prediction that explains little of what the map shows there is a
@@ -327,21 +335,17 @@ bool Tracker::continues_trusted_motion(const Frame& f) const {
   if (o.continuity_s <= 0 || !velocity_ || !last_ || !last_tracked_record_ || !trusted_since_recovery_) return false;
   if (f.data->timestamp - records_[*last_tracked_record_].timestamp > o.continuity_s) return false;
   // The frames since the trusted one are lost: last_ carries the motion model's chained prediction.
-  const geometry::SE3 predicted = predicted_pose(f);
-  const double m = (f.camera_center() - predicted.inverse().translation()).norm();
-  const double deg = geometry::so3_log(f.T_cw.rotation() * predicted.rotation().transpose()).norm() * 180.0 / std::numbers::pi;
-  return m <= options_.jump_deviation_m && deg <= options_.jump_deviation_deg;
+  const auto gap = pose_gap(f.T_cw, predicted_pose(f));
+  return gap.m <= options_.jump_deviation_m && gap.deg <= options_.jump_deviation_deg;
 }
 
 bool Tracker::recovery_confirmed(const Frame& f) const {
   const auto& o = options_.relocalization;
   if (recovery_->frames < o.confirm_frames) return false;
   if (o.confirm_distance_m <= 0 && o.confirm_angle_deg <= 0) return true;
-  const double moved = (f.camera_center() - recovery_->T_cw.inverse().translation()).norm();
-  const double turned =
-      geometry::so3_log(f.T_cw.rotation() * recovery_->T_cw.rotation().transpose()).norm() * 180.0 / std::numbers::pi;
-  return (o.confirm_distance_m > 0 && moved >= o.confirm_distance_m) ||
-         (o.confirm_angle_deg > 0 && turned >= o.confirm_angle_deg);
+  const auto gap = pose_gap(f.T_cw, recovery_->T_cw);
+  return (o.confirm_distance_m > 0 && gap.m >= o.confirm_distance_m) ||
+         (o.confirm_angle_deg > 0 && gap.deg >= o.confirm_angle_deg);
 }
 
 void Tracker::confirm_relocalization(const Frame& f, TrackResult& result) {

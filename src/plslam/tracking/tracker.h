@@ -276,8 +276,9 @@ class Tracker {
   // true for a suspect jump.
   bool check_motion(const Frame& f);
   // Without a velocity (the frame after a relocalization or a new map): whether `f` lies further
-  // from the last tracked pose than a camera at relocalization.max_speed can have moved.
-  bool beyond_reach(const Frame& f) const;
+  // from the last tracked pose than a camera at relocalization.max_speed can have moved (a
+  // suspect jump, recorded).
+  bool beyond_reach(const Frame& f);
   // A recovering frame (tracked from an unconfirmed relocalization): whether it still matches
   // enough of the local map; false refutes the relocalization.
   bool recovery_holds(const Frame& f, bool jumped) const;
