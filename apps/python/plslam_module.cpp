@@ -143,12 +143,14 @@ PYBIND11_MODULE(plslam, m) {
       .def_readonly("timestamp", &TrackedFrame::timestamp)
       .def_property_readonly("state", [](const TrackedFrame& f) { return std::string(to_string(f.state)); })
       .def_property_readonly("frame_state", [](const TrackedFrame& f) { return std::string(to_string(f.frame_state)); },
-                             "tracked, relocalized, localized (trusted poses), recovering or lost")
+                             "tracked, relocalized, localized (trusted poses), recovering, unanchored or lost")
       .def_readonly("tracked", &TrackedFrame::tracked)
       .def_property_readonly("pose", [](const TrackedFrame& f) { return Eigen::Matrix4d(f.T_world_camera.matrix()); },
                              "4x4 T_world_camera of the left camera")
       .def_readonly("point_inliers", &TrackedFrame::point_inliers)
       .def_readonly("line_inliers", &TrackedFrame::line_inliers)
+      .def_readonly("pose_covariance", &TrackedFrame::pose_covariance,
+                    "6x6 covariance of the pose in the camera's frame, (translation, rotation); zeros without a pose")
       .def_readonly("keyframe", &TrackedFrame::keyframe)
       .def_readonly("relocalized", &TrackedFrame::relocalized)
       .def_readonly("new_map_segment", &TrackedFrame::new_map_segment)

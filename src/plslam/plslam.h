@@ -60,8 +60,9 @@ const char* to_string(TrackingState state);
 
 // What a frame's pose is worth: "tracked", "relocalized" (confirmed a relocalization) and
 // "localized" (in a loaded map, localization only) are poses plslam stands behind; "recovering"
-// (tracked from a relocalization not yet confirmed) and "lost" are not.
-enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized };
+// (tracked from a relocalization not yet confirmed), "unanchored" (tracked in a new map segment
+// that no loop has tied to the map: its place in the world is a guess) and "lost" are not.
+enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized, kUnanchored };
 const char* to_string(FrameState state);
 
 struct TrackedFrame {
@@ -76,6 +77,10 @@ struct TrackedFrame {
   Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
   int point_inliers = 0;
   int line_inliers = 0;
+  // The covariance of the pose's final optimisation (the inverse of its information matrix, for
+  // 1 px of noise at the finest level): of xi in T_world_camera_true = T_world_camera exp(xi), xi =
+  // (translation in m, rotation in rad) in the camera's own frame. Zero when the frame has no pose.
+  Eigen::Matrix<double, 6, 6> pose_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool keyframe = false;         // the frame became a keyframe
   bool relocalized = false;      // confirmed being found again in the map after being lost
   bool new_map_segment = false;  // lost for too long: a new, disconnected map started

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstring>
 #include <set>
+#include <stdexcept>
 
 #include "plslam/map/descriptor_utils.h"
 #include "plslam/geometry/stereo_camera.h"
@@ -95,6 +96,27 @@ TEST(Map, FirstKeyframeIsNeverCulled) {
   Fixture f;
   f.k[0]->set_bad();
   EXPECT_FALSE(f.k[0]->is_bad());
+}
+
+TEST(Map, ASegmentIsAnchoredOnceALoopTiesItToTheFirst) {
+  Map m;
+  KeyFrame* k0 = m.create_keyframe(make_data(0, 10), geometry::SE3());
+  EXPECT_EQ(k0->segment(), 0);
+  EXPECT_TRUE(m.anchored(0));
+  const int s1 = m.start_segment(), s2 = m.start_segment(), s3 = m.start_segment();
+  EXPECT_EQ(m.num_segments(), 4);
+  KeyFrame* k1 = m.create_keyframe(make_data(1, 10), geometry::SE3(), s1);
+  EXPECT_EQ(k1->segment(), s1);
+  EXPECT_THROW(m.create_keyframe(make_data(2, 10), geometry::SE3(), 7), std::invalid_argument);
+  EXPECT_FALSE(m.anchored(s1));
+  // Two new segments tied to each other are still both guesses.
+  m.tie_segments(s3, s2);
+  EXPECT_FALSE(m.anchored(s2));
+  EXPECT_FALSE(m.anchored(s3));
+  // Tied to one of them, then that set to the first: all anchored, whichever order.
+  m.tie_segments(s1, s3);
+  m.tie_segments(s2, 0);
+  for (int s : {0, s1, s2, s3}) EXPECT_TRUE(m.anchored(s)) << s;
 }
 
 TEST(Map, TheOriginIsTheFirstKeyframeWhateverItsId) {

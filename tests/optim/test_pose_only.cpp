@@ -76,6 +76,50 @@ TEST(PoseOnly, FarInitialGuessReincludesInliers) {
   expect_accurate(run_trials(300, 100, 10, 4, 0.4, 0.06));
 }
 
+// The covariance from the information matrix is consistent: over many frames with 1 px of
+// Gaussian noise (the noise the information assumes), the NEES of the pose error averages the 6
+// degrees of freedom. The 95 % gates drop the tail of the inliers, which lowers it a little.
+double mean_pose_nees(int n_points, int n_lines, unsigned seed) {
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(seed);
+  PoseOnlyOptions o;
+  o.covariance = true;
+  double sum = 0;
+  const int trials = 300;
+  for (int t = 0; t < trials; ++t) {
+    const SE3 T_true = test::random_pose(rng, 5.0, 1.0);
+    const auto scene = test::make_pose_only_scene(cam, T_true, n_points, n_lines, 1.0, 0.0, rng);
+    const PoseOnlyResult res = optimize_pose(cam, test::random_pose(rng, 0.05, 0.01) * T_true, scene.points,
+                                             scene.lines, o);
+    EXPECT_FALSE(res.covariance.isZero(0));
+    EXPECT_TRUE(res.covariance.isApprox(res.covariance.transpose()));
+    // T_cw_true = exp(delta) T_cw: the perturbation the covariance is of.
+    const geometry::Vector6d delta = (T_true * res.T_cw.inverse()).log();
+    sum += delta.dot(res.covariance.inverse() * delta);
+  }
+  const double mean = sum / trials;
+  std::printf("%d points %d lines: mean NEES %.2f over %d frames (6 expected)\n", n_points, n_lines, mean, trials);
+  return mean;
+}
+
+TEST(PoseOnly, CovarianceOfStereoPointsIsConsistent) {
+  const double m = mean_pose_nees(80, 0, 11);
+  EXPECT_GT(m, 5.0);
+  EXPECT_LT(m, 7.0);
+}
+
+TEST(PoseOnly, CovarianceIsZeroWhenADirectionIsUnobserved) {
+  const auto cam = test::kitti_like_camera();
+  std::mt19937 rng(5);
+  const auto scene = test::make_pose_only_scene(cam, SE3(), 1, 0, 0.0, 0.0, rng);  // one point: rank 3
+  PoseOnlyOptions o;
+  o.covariance = true;
+  EXPECT_TRUE(optimize_pose(cam, SE3(), scene.points, {}, o).covariance.isZero(0));
+  o.covariance = false;
+  const auto full = test::make_pose_only_scene(cam, SE3(), 50, 0, 1.0, 0.0, rng);
+  EXPECT_TRUE(optimize_pose(cam, SE3(), full.points, {}, o).covariance.isZero(0));  // not asked for
+}
+
 TEST(PoseOnly, ExactObservationsGiveExactPose) {
   const auto cam = test::kitti_like_camera();
   std::mt19937 rng(5);

@@ -84,8 +84,14 @@ def test_track_refuses_wrong_images_and_timestamps(office_short):
         slam.track(np.zeros((2, 2, 2, 2), np.uint8), right, t)
     f = slam.track(left, right, t)
     assert f.index == 0 and f.tracked and f.state == "tracking" and f.frame_state == "tracked"
+    assert f.pose_covariance.shape == (6, 6) and not f.pose_covariance.any()  # the first frame is the world
     with pytest.raises(plslam.InputError, match="does not follow"):
         slam.track(left, right, t)
+    g = slam.track(*ds[1][1:], ds[1][0])
+    assert g.tracked and g.point_inliers > 0
+    cov = g.pose_covariance
+    assert np.allclose(cov, cov.T) and np.all(np.linalg.eigvalsh(cov) > 0)
+    assert 0 < cov[0, 0] < 1e-4  # a standard deviation under 1 cm
     slam.shutdown()
     with pytest.raises(RuntimeError):
         slam.track(left, right, t + 1)

@@ -132,7 +132,11 @@ TEST(RelocalizationConcurrent, KidnappedKittiCameraIsFoundAgainWhileLocalMapping
   const auto reloc = stats["relocalizations"]["frames"].get<std::vector<long>>();
   ASSERT_EQ(reloc.size(), 1u) << stats.dump(2);
   EXPECT_LT(reloc.front(), kTextureReturns + 3);
-  EXPECT_GE(stats["tracked_frames"].get<int>(), 51 + 21 - 2);
+  // Every frame from the relocalization's confirmation on is tracked: the KITTI preset trusts the
+  // third frame of a relocalization (confirm_frames 3). Which replayed frame relocalizes first
+  // depends on how far local mapping has filled the database (frame 72 on a loaded machine).
+  const long untrusted_replay = reloc.front() - kTextureReturns + 2;
+  EXPECT_GE(stats["tracked_frames"].get<long>(), 51 + 21 - untrusted_replay);
   // The global BA after the revisit runs in its own thread beside tracking and local mapping.
   EXPECT_EQ(stats["loop_closing"]["global_ba_after_relocalization"], 1);
   EXPECT_EQ(stats["global_ba_runs"].get<int>() + stats["global_ba_aborted"].get<int>(), 1);
@@ -261,6 +265,15 @@ TEST(Relocalization, WithoutPlaceRecognitionALostCameraStartsANewSegment) {
   EXPECT_EQ(r.stats["relocalizations"]["count"], 0);
   EXPECT_EQ(r.stats["new_map_segments"]["frames"], nlohmann::json::array({kTextureReturns + 1}));
   EXPECT_EQ(r.stats["place_recognition"]["enabled"], false);
+  // The segment starts where the motion model guessed, 1 s of darkness and a kidnapping later: its
+  // frames (72-76) are unanchored, and trajectory.tum holds only the first segment's.
+  const auto states = states_by_frame(r.out);
+  for (long f = kTextureReturns + 1; f <= kTextureReturns + 5; ++f) EXPECT_EQ(states.at(f), "unanchored") << f;
+  EXPECT_EQ(r.stats["frame_states"]["unanchored"], 5);
+  EXPECT_EQ(r.stats["frame_states"]["tracked"], r.stats["tracked_frames"]);
+  const auto tum = io::read_trajectory(r.out / "trajectory.tum", io::TrajectoryFormat::kTum);
+  EXPECT_EQ(tum.size(), r.stats["tracked_frames"].get<std::size_t>());
+  EXPECT_LT(tum.back().t, 0.1 * kTextureReturns - 0.05);  // (times at 10 Hz)
 }
 
 TEST(Relocalization, KeepsFailingForOneSecondThenStartsANewSegment) {

@@ -216,6 +216,21 @@ TEST(Tracker, WithoutPlaceRecognitionALostCameraStartsANewMapSegment) {
   EXPECT_TRUE(rig.inserted.front()->is_origin());
   EXPECT_FALSE(rig.inserted.back()->is_origin());
   EXPECT_EQ(rig.map.first_keyframe(), rig.inserted.front());
+  // Its frames are right relative to each other, but where it lies is the motion model's guess
+  // across the loss: unanchored, not trusted, until a loop ties it to the first segment.
+  EXPECT_EQ(back.frame_state, FrameState::kUnanchored);
+  EXPECT_FALSE(back.tracked);
+  const int segment = rig.inserted.back()->segment();
+  EXPECT_NE(segment, 0);
+  const TrackResult next = rig.tracker.track(world.observe(walk(5), 5).data);
+  EXPECT_EQ(next.frame_state, FrameState::kUnanchored);
+  rig.tracker.settle_states();
+  EXPECT_EQ(rig.tracker.records().back().state, FrameState::kUnanchored);
+  rig.map.tie_segments(segment, 0);
+  rig.tracker.settle_states();
+  EXPECT_EQ(rig.tracker.records().back().state, FrameState::kTracked);
+  EXPECT_EQ(rig.tracker.records()[4].state, FrameState::kTracked);
+  EXPECT_EQ(rig.tracker.records()[3].state, FrameState::kLost);
 }
 
 }  // namespace tracker_test

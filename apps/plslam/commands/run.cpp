@@ -344,6 +344,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     spdlog::warn("{}: stopping; writing the outputs of the {} frames processed", app::stop_signal_name(), report.frames);
   }
   slam.finish();
+  report.settle(slam.tracker().records());
 
   if (!args.save_map.empty() && slam.map().first_keyframe()) {
     // After local mapping and loop closing (and its global BA) finished: the map as it ends.
@@ -431,6 +432,15 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
       const auto accuracy = system::evaluate_against_ground_truth(*ds, traj);
       stats["accuracy"] = accuracy;
       std::cout << system::format_accuracy(accuracy);
+      // Is the pose covariance (frames.csv cov_*) consistent with the errors? 6 when it is.
+      const auto nees = system::motion_nees_json(*ds, report.covariant_poses(traj));
+      stats["accuracy"]["motion_nees"] = nees;
+      if (nees["motions"].get<std::size_t>() > 0) {
+        std::cout << fmt::format("pose covariance: mean NEES {:.2f} (median {:.2f}) of {} frame-to-frame motions, "
+                                 "6 if consistent\n",
+                                 nees["mean"].get<double>(), nees["median"].get<double>(),
+                                 nees["motions"].get<std::size_t>());
+      }
     } catch (const InputError& e) {
       // Too few tracked poses to score (or a degenerate alignment): say so instead of a number.
       spdlog::warn("no accuracy: {}", e.what());

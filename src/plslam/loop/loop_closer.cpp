@@ -348,6 +348,8 @@ bool LoopCloser::close_loop(map::KeyFrame* kf) {
   {
     std::lock_guard map_lock(map_.update_mutex());
     corrected = correct_loop(map_, *loop, options_.correction);
+    // A loop into an anchored segment brings a new segment's keyframes into the map's frame.
+    map_.tie_segments(kf->segment(), loop->candidate->segment());
   }
   const double ms = ms_since(t0);
   detector_.reset();

@@ -7,8 +7,9 @@
 
 namespace plslam::map {
 
-KeyFrame::KeyFrame(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw, bool origin)
-    : id_(id), origin_(origin), data_(std::move(data)), T_cw_(T_cw), T_wc_(T_cw.inverse()),
+KeyFrame::KeyFrame(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw, bool origin,
+                   int segment)
+    : id_(id), origin_(origin), segment_(segment), data_(std::move(data)), T_cw_(T_cw), T_wc_(T_cw.inverse()),
       points_(data_->keypoints.size(), nullptr), lines_(data_->lines.size(), nullptr) {}
 
 geometry::SE3 KeyFrame::pose() const {

@@ -22,13 +22,17 @@ class MapLine;
 
 class KeyFrame {
  public:
-  // `origin`: the map's first keyframe (Map::first_keyframe()), whatever its id.
-  KeyFrame(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw, bool origin = false);
+  // `origin`: the map's first keyframe (Map::first_keyframe()), whatever its id. `segment`: the
+  // map segment it was made in (Map::start_segment()).
+  KeyFrame(long id, std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw, bool origin = false,
+           int segment = 0);
 
   long id() const { return id_; }
   // The keyframe that holds the map's gauge: never culled, fixed in local and global BA. It is the
   // map's first keyframe, which need not have id 0 (a loaded map's first one is its lowest id).
   bool is_origin() const { return origin_; }
+  // The map segment whose frame its pose is in (Map::anchored() tells whether that is the map's).
+  int segment() const { return segment_; }
   const FrameData& data() const { return *data_; }
   const std::shared_ptr<const FrameData>& shared_data() const { return data_; }
   long frame_id() const { return data_->frame_id; }
@@ -97,6 +101,7 @@ class KeyFrame {
  private:
   const long id_;
   const bool origin_;
+  const int segment_;
   const std::shared_ptr<const FrameData> data_;
 
   mutable std::mutex pose_mutex_;

@@ -6,11 +6,15 @@
 
 namespace plslam::map {
 
-KeyFrame* Map::create_keyframe(std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw) {
+KeyFrame* Map::create_keyframe(std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw, int segment) {
   std::lock_guard lock(mutex_);
   ++changes_;
+  if (segment < 0 || segment >= static_cast<int>(segment_parent_.size())) {
+    throw std::invalid_argument("unknown map segment " + std::to_string(segment));
+  }
   const bool origin = all_keyframes_.empty();
-  all_keyframes_.push_back(std::make_unique<KeyFrame>(next_keyframe_id_++, std::move(data), T_cw, origin));
+  all_keyframes_.push_back(
+      std::make_unique<KeyFrame>(next_keyframe_id_++, std::move(data), T_cw, origin, segment));
   keyframes_.insert(all_keyframes_.back().get());
   return all_keyframes_.back().get();
 }
@@ -179,6 +183,36 @@ std::size_t Map::num_lines() const { return lines().size(); }
 Map::Sizes Map::sizes() const {
   std::lock_guard lock(mutex_);
   return {keyframes_.size(), points_.size(), lines_.size()};
+}
+
+int Map::start_segment() {
+  std::lock_guard lock(mutex_);
+  segment_parent_.push_back(static_cast<int>(segment_parent_.size()));
+  return segment_parent_.back();
+}
+
+int Map::segment_root(int s) const {
+  while (segment_parent_.at(static_cast<std::size_t>(s)) != s) s = segment_parent_[static_cast<std::size_t>(s)];
+  return s;
+}
+
+void Map::tie_segments(int a, int b) {
+  std::lock_guard lock(mutex_);
+  const int ra = segment_root(a), rb = segment_root(b);
+  if (ra == rb) return;
+  // The smaller root stays: segment 0 is always its set's root, so anchored() asks for root 0.
+  segment_parent_[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+  ++changes_;
+}
+
+bool Map::anchored(int segment) const {
+  std::lock_guard lock(mutex_);
+  return segment_root(segment) == 0;
+}
+
+int Map::num_segments() const {
+  std::lock_guard lock(mutex_);
+  return static_cast<int>(segment_parent_.size());
 }
 
 KeyFrame* Map::first_keyframe() const {

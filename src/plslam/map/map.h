@@ -24,7 +24,8 @@ class Map {
   Map(const Map&) = delete;
   Map& operator=(const Map&) = delete;
 
-  KeyFrame* create_keyframe(std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw);
+  // `segment`: the map segment whose frame T_cw is in (start_segment()).
+  KeyFrame* create_keyframe(std::shared_ptr<const FrameData> data, const geometry::SE3& T_cw, int segment = 0);
   MapPoint* create_point(const Eigen::Vector3d& position, KeyFrame* reference, long frame_id);
   MapLine* create_line(const Eigen::Vector3d& start, const Eigen::Vector3d& end, KeyFrame* reference,
                        long frame_id);
@@ -78,6 +79,15 @@ class Map {
   // The first keyframe created or restored: the origin (KeyFrame::is_origin()), whatever its id.
   KeyFrame* first_keyframe() const;
 
+  // Map segments. A lost camera that cannot relocalize starts a new, disconnected segment whose
+  // frame is only the motion model's guess of where the camera went. Segment 0 (the first map, or
+  // a loaded one) is anchored: its frame is the map's. Another segment is anchored once a loop ties
+  // it to an anchored one; until then its poses are right relative to each other only.
+  int start_segment();                 // a new, unanchored segment's number
+  void tie_segments(int a, int b);     // a loop between keyframes of segments a and b
+  bool anchored(int segment) const;
+  int num_segments() const;
+
   // Held by whoever changes poses or structure wholesale (local BA write-back) and by tracking
   // while it reads them, so that tracking never sees half an update (ORB-SLAM2's mMutexMapUpdate).
   std::mutex& update_mutex() const { return update_mutex_; }
@@ -111,6 +121,10 @@ class Map {
   mutable IdSet<MapPoint> points_;
   mutable IdSet<MapLine> lines_;
   long next_keyframe_id_ = 0, next_point_id_ = 0, next_line_id_ = 0;
+  // Union-find over segments (guarded by mutex_): segment_parent_[s] == s at a root, and a root
+  // is anchored when its set holds segment 0.
+  std::vector<int> segment_parent_{0};
+  int segment_root(int s) const;
 };
 
 }  // namespace plslam::map

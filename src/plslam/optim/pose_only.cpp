@@ -177,6 +177,17 @@ PoseOnlyResult optimize_pose(const geometry::StereoCamera& cam, const SE3& T_cw_
     changed = prev_points != res.point_outlier || prev_lines != res.line_outlier;
   }
   res.T_cw = T;
+  if (options.covariance) {
+    Matrix6d H = Matrix6d::Zero();
+    Vector6d g = Vector6d::Zero();
+    evaluate(p, T, res.point_outlier, res.line_outlier, /*robust=*/false, &H, &g);
+    const Eigen::LDLT<Matrix6d> ldlt(H);
+    // A direction no inlier observes (a rank-deficient H) has no finite covariance.
+    if (ldlt.info() == Eigen::Success && ldlt.isPositive() && (ldlt.vectorD().array() > 1e-9 * H.diagonal().maxCoeff()).all()) {
+      res.covariance = ldlt.solve(Matrix6d::Identity());
+      res.covariance = 0.5 * (res.covariance + res.covariance.transpose()).eval();
+    }
+  }
   for (const bool o : res.point_outlier) res.num_point_inliers += o ? 0 : 1;
   for (const bool o : res.line_outlier) res.num_line_inliers += o ? 0 : 1;
   return res;

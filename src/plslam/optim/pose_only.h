@@ -36,6 +36,8 @@ struct PoseOnlyOptions {
   double chi2_point_mono = kChi2Mono2Dof;
   double chi2_line_pair = kChi2LinePair2Dof;
   double scale_factor = 1.2;  // pyramid scale: sigma^2 = scale^(2 level)
+  // Also return the pose's covariance (PoseOnlyResult::covariance): one more pass over the terms.
+  bool covariance = false;
 };
 
 struct PoseOnlyResult {
@@ -48,6 +50,13 @@ struct PoseOnlyResult {
   // last round is not robust).
   double final_cost = 0.0;
   int iterations = 0;  // LM iterations actually run
+  // With PoseOnlyOptions::covariance: the inverse of the information matrix J' Omega J of the final
+  // inliers at T_cw (no kernel), for the left perturbation T_cw_true = exp(delta) T_cw, delta =
+  // (translation, rotation). That is also the covariance of xi in T_wc_true = T_wc exp(xi): the
+  // camera's pose error in its own frame. Pixel noise is taken as 1 px at level 0 (the levels'
+  // sigma^2 = scale^(2 level)), as in every other information matrix. Zero when the inliers leave
+  // a direction unobserved.
+  geometry::Matrix6d covariance = geometry::Matrix6d::Zero();
 };
 
 PoseOnlyResult optimize_pose(const geometry::StereoCamera& cam, const geometry::SE3& T_cw_init,

@@ -40,7 +40,8 @@ namespace {
 static_assert(static_cast<int>(FrameState::kLocalized) == static_cast<int>(tracking::FrameState::kLocalized) &&
                   static_cast<int>(FrameState::kRecovering) == static_cast<int>(tracking::FrameState::kRecovering) &&
                   static_cast<int>(FrameState::kRelocalized) == static_cast<int>(tracking::FrameState::kRelocalized) &&
-                  static_cast<int>(FrameState::kTracked) == static_cast<int>(tracking::FrameState::kTracked),
+                  static_cast<int>(FrameState::kTracked) == static_cast<int>(tracking::FrameState::kTracked) &&
+                  static_cast<int>(FrameState::kUnanchored) == static_cast<int>(tracking::FrameState::kUnanchored),
               "the public FrameState mirrors tracking::FrameState");
 
 TrackingState public_state(tracking::TrackingState s) {
@@ -195,6 +196,7 @@ TrackedFrame Slam::track(const cv::Mat& left, const cv::Mat& right, double times
   }
   out.point_inliers = r.track.point_inliers;
   out.line_inliers = r.track.line_inliers;
+  out.pose_covariance = r.track.pose_covariance;
   out.keyframe = r.track.keyframe;
   out.relocalized = r.track.relocalized;
   out.new_map_segment = r.track.new_map_segment;

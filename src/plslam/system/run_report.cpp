@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <numeric>
+#include <unordered_map>
 
 #include <fmt/format.h>
 
@@ -47,27 +48,56 @@ nlohmann::json global_ba_ms(const System& slam) {
 
 }  // namespace
 
-const char* RunReport::frames_csv_header() {
-  return "frame,timestamp,state,tracked,keyframe,keyframe_reason,point_inliers,line_inliers,reference_tracked,"
-         "keyframe_threshold,delta_pid,speed_mps,tracked_close,untracked_close,local_keyframes,local_points,"
-         "local_lines,stereo_points,stereo_lines,tracking_ms,map_keyframes,map_points,map_lines,rss_mb";
+std::string RunReport::frames_csv_header() {
+  std::string h =
+      "frame,timestamp,state,tracked,keyframe,keyframe_reason,point_inliers,line_inliers,reference_tracked,"
+      "keyframe_threshold,delta_pid,speed_mps,tracked_close,untracked_close,local_keyframes,local_points,"
+      "local_lines,stereo_points,stereo_lines,tracking_ms,map_keyframes,map_points,map_lines,rss_mb";
+  static constexpr std::array<const char*, 6> kAxes{"tx", "ty", "tz", "rx", "ry", "rz"};
+  for (std::size_t a = 0; a < 6; ++a) {
+    for (std::size_t b = a; b < 6; ++b) h += fmt::format(",cov_{}_{}", kAxes[a], kAxes[b]);
+  }
+  return h;
 }
 
 void RunReport::write_frames_csv(std::ostream& out) const {
   out << frames_csv_header() << "\n";
-  for (const auto& row : frame_rows) out << row << "\n";
+  for (const auto& row : frame_rows) {
+    out << fmt::format("{},{:.9f},{},{},", row.frame, row.timestamp, tracking::to_string(row.state),
+                       tracking::is_trusted(row.state) ? 1 : 0)
+        << row.rest << "\n";
+  }
+}
+
+void RunReport::settle(const std::vector<tracking::FrameRecord>& records) {
+  std::unordered_map<long, tracking::FrameState> settled;
+  for (const auto& rec : records) settled[rec.frame_id] = rec.state;
+  for (auto& row : frame_rows) {
+    const auto it = settled.find(row.frame);
+    if (it == settled.end() || it->second == row.state) continue;
+    --state_counts[static_cast<std::size_t>(row.state)];
+    ++state_counts[static_cast<std::size_t>(it->second)];
+    tracked_frames += static_cast<std::size_t>(tracking::is_trusted(it->second)) -
+                      static_cast<std::size_t>(tracking::is_trusted(row.state));
+    row.state = it->second;
+  }
 }
 
 void RunReport::add(const FrameResult& r) {
   const auto& in = r.track.keyframe_inputs;
   const auto& d = r.track.decision;
-  frame_rows.push_back(fmt::format(
-      "{},{:.9f},{},{},{},{},{},{},{},{:.2f},{:.2f},{:.3f},{},{},{},{},{},{},{},{:.3f},{},{},{},{:.1f}", r.frame_id, r.timestamp,
-      tracking::to_string(r.track.frame_state), r.track.tracked ? 1 : 0, r.track.keyframe ? 1 : 0,
+  frame_rows.push_back({r.frame_id, r.timestamp, r.track.frame_state, fmt::format(
+      "{},{},{},{},{},{:.2f},{:.2f},{:.3f},{},{},{},{},{},{},{},{:.3f},{},{},{},{:.1f}", r.track.keyframe ? 1 : 0,
       r.track.keyframe ? (r.track.decision.insert ? tracking::to_string(d.reason) : "new-map") : "", r.track.point_inliers, r.track.line_inliers,
       in.reference_tracked, d.threshold, d.delta_pid, d.speed, in.tracked_close, in.untracked_close,
       r.track.local_keyframes, r.track.local_points, r.track.local_lines, r.extraction.stereo_points,
-      r.extraction.stereo_lines, r.tracking_ms, r.map_size.keyframes, r.map_size.points, r.map_size.lines, r.rss_mb));
+      r.extraction.stereo_lines, r.tracking_ms, r.map_size.keyframes, r.map_size.points, r.map_size.lines, r.rss_mb)});
+  const auto& cov = r.track.pose_covariance;
+  frame_rows.back().covariance = cov;
+  const bool has_cov = !cov.isZero(0);
+  for (int a = 0; a < 6; ++a) {
+    for (int b = a; b < 6; ++b) frame_rows.back().rest += has_cov ? fmt::format(",{:.4e}", cov(a, b)) : ",";
+  }
   ++frames;
   if (r.track.tracked) ++tracked_frames;
   ++state_counts[static_cast<std::size_t>(r.track.frame_state)];
@@ -191,13 +221,14 @@ std::string RunReport::summary(const System& slam) const {
   return fmt::format(
       "frames {} (tracked {}, skipped {}), lost events {}, relocalizations {}, new map segments {}, loops {}, "
       "keyframes {}, map points {}, map lines {}\n"
-      "frame states: tracked {}, relocalized {}, localized {}, recovering {}, lost {}\n"
+      "frame states: tracked {}, relocalized {}, localized {}, recovering {}, unanchored {}, lost {}\n"
       "tracking ms/frame: median {:.1f}, mean {:.1f}, p90 {:.1f}\n",
       frames, tracked_frames, skipped.size(), slam.tracker().lost_events(), slam.tracker().relocalized_frames().size(),
       slam.tracker().new_segment_frames().size(), slam.loop_closer() ? slam.loop_closer()->stats().loops.size() : 0,
       slam.map().num_keyframes(), slam.map().num_points(),
       slam.map().num_lines(), count(FrameState::kTracked), count(FrameState::kRelocalized),
-      count(FrameState::kLocalized), count(FrameState::kRecovering), count(FrameState::kLost),
+      count(FrameState::kLocalized), count(FrameState::kRecovering), count(FrameState::kUnanchored),
+      count(FrameState::kLost),
       percentile(tracking_ms, 0.5), mean(tracking_ms), percentile(tracking_ms, 0.9));
 }
 
@@ -272,6 +303,24 @@ nlohmann::json evaluate_in_map_frame(const io::Dataset& dataset, const Trajector
   auto j = eval::to_json(eval::evaluate(*dataset.ground_truth(), in_gt, o));
   j["ground_truth"] = dataset.ground_truth_path().string();
   return j;
+}
+
+std::vector<eval::CovariantPose> RunReport::covariant_poses(const Trajectory& trajectory) const {
+  std::vector<eval::CovariantPose> out;
+  std::size_t row = 0;
+  for (const auto& p : trajectory) {
+    // Both in processing order: the trajectory's poses are the trusted rows'.
+    while (row < frame_rows.size() && frame_rows[row].timestamp < p.t) ++row;
+    if (row == frame_rows.size()) break;
+    if (frame_rows[row].timestamp == p.t) out.push_back({p.t, geometry::SE3(p.T), frame_rows[row].covariance});
+  }
+  return out;
+}
+
+nlohmann::json motion_nees_json(const io::Dataset& dataset, const std::vector<eval::CovariantPose>& poses) {
+  const double period = dataset.fps() > 0 ? 1.0 / dataset.fps() : 0.1;
+  const auto r = eval::motion_nees(*dataset.ground_truth(), poses, 1.5 * period);
+  return {{"mean", r.mean}, {"median", r.median}, {"motions", r.nees.size()}, {"dof", r.dof}};
 }
 
 std::string format_accuracy(const nlohmann::json& a) {

@@ -154,6 +154,7 @@ void System::finish() {
     loop_closer_->finish();
     loop_closer_->stop();
   }
+  tracker_->settle_states();
 }
 
 void System::load_map(const MapContents& contents) {
@@ -194,7 +195,10 @@ std::optional<long> System::initialized_at() const {
 
 Trajectory System::keyframe_trajectory() const {
   Trajectory out;
-  for (auto* kf : map_.keyframes()) out.push_back({kf->timestamp(), kf->pose_inverse().isometry()});
+  for (auto* kf : map_.keyframes()) {
+    // A keyframe of a segment no loop tied to the map is placed by a guess: not a trusted pose.
+    if (map_.anchored(kf->segment())) out.push_back({kf->timestamp(), kf->pose_inverse().isometry()});
+  }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
   return out;
 }

@@ -30,6 +30,8 @@ struct Frame {
   std::vector<map::MapLine*> lines;
   std::vector<bool> line_outlier;
   map::KeyFrame* reference = nullptr;
+  // Of the last pose optimisation against the local map (optim::PoseOnlyResult::covariance).
+  geometry::Matrix6d pose_covariance = geometry::Matrix6d::Zero();
 
   long id() const { return data->frame_id; }
   Eigen::Vector3d camera_center() const { return T_cw.inverse().translation(); }

@@ -48,6 +48,7 @@ const char* to_string(FrameState s) {
     case FrameState::kRelocalized: return "relocalized";
     case FrameState::kTracked: return "tracked";
     case FrameState::kLocalized: return "localized";
+    case FrameState::kUnanchored: return "unanchored";
   }
   return "?";
 }
@@ -284,6 +285,8 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       fs = FrameState::kRecovering;
     } else if (options_.localization_only) {
       fs = FrameState::kLocalized;
+    } else if (f.reference && !map_.anchored(f.reference->segment())) {
+      fs = FrameState::kUnanchored;
     } else {
       fs = result.relocalized ? FrameState::kRelocalized : FrameState::kTracked;
     }
@@ -302,9 +305,18 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   }
   result.state = state_;
   result.frame_state = fs;
+  if (ok) result.pose_covariance = f.pose_covariance;
   result.tracked = rec.trusted();
   last_ = std::move(f);
   return result;
+}
+
+void Tracker::settle_states() {
+  for (auto& rec : records_) {
+    if (rec.state == FrameState::kUnanchored && rec.reference && map_.anchored(rec.reference->segment())) {
+      rec.state = FrameState::kTracked;
+    }
+  }
 }
 
 bool Tracker::relocalize_and_track(Frame& f, TrackResult& result) {
@@ -395,7 +407,9 @@ bool Tracker::should_start_new_segment(const Frame& f) {
 bool Tracker::initialize(Frame& f) {
   const auto& d = *f.data;
   if (!can_start_map(f)) return false;
-  map::KeyFrame* kf = map_.create_keyframe(f.data, f.T_cw);
+  // The first map is segment 0, anchored; a later one starts where the motion model guesses.
+  const int segment = map_.first_keyframe() ? map_.start_segment() : 0;
+  map::KeyFrame* kf = map_.create_keyframe(f.data, f.T_cw, segment);
   for (std::size_t i = 0; i < d.keypoints.size(); ++i) {
     if (d.depth[i] > 0) create_stereo_point(f, kf, i);
   }
@@ -420,7 +434,7 @@ bool Tracker::initialize(Frame& f) {
   return true;
 }
 
-int Tracker::optimize_pose(Frame& f, TrackStageTimes& t) {
+int Tracker::optimize_pose(Frame& f, TrackStageTimes& t, bool covariance) {
   const auto t0 = Clock::now();
   const auto& d = *f.data;
   std::vector<optim::PosePointTerm> pts;
@@ -448,8 +462,10 @@ int Tracker::optimize_pose(Frame& f, TrackStageTimes& t) {
   const geometry::StereoCamera cam(d.calib);
   auto popts = options_.pose;
   popts.scale_factor = d.scale_factor;
+  popts.covariance = covariance;
   const auto r = optim::optimize_pose(cam, f.T_cw, pts, lns, popts);
   f.T_cw = r.T_cw.normalized();
+  f.pose_covariance = r.covariance;
   for (std::size_t k = 0; k < pidx.size(); ++k) f.point_outlier[pidx[k]] = r.point_outlier[k];
   for (std::size_t k = 0; k < lidx.size(); ++k) f.line_outlier[lidx[k]] = r.line_outlier[k];
   t.pose_optimization_ms += ms_since(t0);
@@ -622,7 +638,7 @@ bool Tracker::track_local_map(Frame& f, TrackStageTimes& t, int& point_inliers, 
   update_local_map(f);
   search_points_in_local_map(f, local_points_, options_.local_map_radius, options_.search);
   if (options_.lines) search_lines(f, local_lines_, options_.line_radius, options_.search);
-  optimize_pose(f, t);
+  optimize_pose(f, t, /*covariance=*/true);
   point_inliers = 0;
   line_inliers = 0;
   for (std::size_t i = 0; i < f.points.size(); ++i) {
@@ -707,7 +723,9 @@ void Tracker::create_stereo_line(Frame& f, map::KeyFrame* kf, std::size_t j) {
 
 map::KeyFrame* Tracker::create_keyframe(Frame& f) {
   const auto& d = *f.data;
-  map::KeyFrame* kf = map_.create_keyframe(f.data, f.T_cw);
+  // The frame's pose is in its reference keyframe's segment (a relocalization into the first map
+  // leaves a new segment behind).
+  map::KeyFrame* kf = map_.create_keyframe(f.data, f.T_cw, reference_ ? reference_->segment() : 0);
   // Tracked map points and lines: associated now, observations added by local mapping.
   for (std::size_t i = 0; i < f.points.size(); ++i) {
     if (f.points[i] && !f.point_outlier[i]) kf->add_map_point(f.points[i], static_cast<int>(i));

@@ -133,11 +133,18 @@ const char* to_string(TrackingState s);
 //   recovering   tracked from a relocalization not yet confirmed: a pose, but not trusted;
 //   relocalized  the frame that confirmed a relocalization: trusted;
 //   localized    tracked in a loaded map, localization only (--localize): trusted;
-//   lost         no pose (lost, or before the map started).
-enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized };
+//   lost         no pose (lost, or before the map started);
+//   unanchored   tracked in a new map segment that no loop has tied to the map yet: right
+//                relative to the segment's other frames, but the segment's place in the map is
+//                the motion model's guess across the loss. Not trusted; the run's outputs count
+//                it tracked if a loop ties the segment before the end (Tracker::settle_states).
+enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized, kUnanchored };
 const char* to_string(FrameState s);
 // The states whose pose plslam stands behind (trajectory.tum holds only these).
-constexpr bool is_trusted(FrameState s) { return s != FrameState::kLost && s != FrameState::kRecovering; }
+constexpr bool is_trusted(FrameState s) {
+  return s != FrameState::kLost && s != FrameState::kRecovering && s != FrameState::kUnanchored;
+}
+constexpr int kFrameStates = 6;
 
 struct TrackStageTimes {
   double track_motion_ms = 0;     // motion model or reference keyframe, search + optimisation
@@ -153,6 +160,10 @@ struct TrackResult {
   bool tracked = false;
   int point_inliers = 0;
   int line_inliers = 0;
+  // Of the pose (when the frame has one and its final optimisation observed every direction):
+  // optim::PoseOnlyResult::covariance, the camera's pose error in its own frame, (translation,
+  // rotation). Zero otherwise.
+  geometry::Matrix6d pose_covariance = geometry::Matrix6d::Zero();
   bool keyframe = false;
   bool relocalized = false;      // confirmed a relocalization (FrameState::kRelocalized)
   bool new_map_segment = false;  // a lost camera started a new, disconnected map segment
@@ -218,6 +229,9 @@ class Tracker {
   const std::vector<long>& refuted_relocalizations() const { return refuted_relocalizations_; }
   const std::vector<long>& new_segment_frames() const { return new_segment_frames_; }
   const std::vector<FrameRecord>& records() const { return records_; }
+  // At the end of a run: the frames of a segment that a loop tied to the map after they were
+  // tracked become tracked (their poses follow their reference keyframes into the map's frame).
+  void settle_states();
   // The ids of the local map the last frame was tracked against (the live viewer highlights it);
   // tracking thread, between frames.
   std::vector<long> local_keyframe_ids() const;
@@ -262,7 +276,8 @@ class Tracker {
   bool can_start_map(const Frame& f) const;
   // The keyframe decision and bookkeeping of a tracked frame.
   void finish_tracked_frame(Frame& f, TrackResult& result);
-  int optimize_pose(Frame& f, TrackStageTimes& t);
+  // `covariance`: also the pose's (Frame::pose_covariance), for the final optimisation.
+  int optimize_pose(Frame& f, TrackStageTimes& t, bool covariance = false);
   void update_local_map(Frame& f);
   map::KeyFrame* create_keyframe(Frame& f);
   // A map point (line) from the frame's stereo depth (3D endpoints), observed by `kf`.
