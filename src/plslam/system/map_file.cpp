@@ -508,7 +508,22 @@ MapContents capture_map(const map::Map& map, const place::KeyframeDatabase* data
   c.meta = std::move(meta);
   c.meta.version = kMapFileVersion;
   c.meta.next_ids = map.next_ids();
-  const auto keyframes = map.keyframes();
+  // A new map segment no loop tied to the map lies where a guess put it: a map file holds only the
+  // map's own frame (a loaded map is all anchored, so a guessed part would localize as trusted).
+  std::vector<map::KeyFrame*> keyframes;
+  std::size_t unanchored = 0;
+  for (auto* kf : map.keyframes()) {
+    if (map.anchored(kf->segment())) {
+      keyframes.push_back(kf);
+    } else {
+      ++unanchored;
+    }
+  }
+  if (unanchored > 0) {
+    spdlog::warn("map file: {} keyframes of map segments not tied to the map left out (and the points and lines "
+                 "only they observe)",
+                 unanchored);
+  }
   std::set<long> saved;
   for (const auto* kf : keyframes) saved.insert(kf->id());
   auto known = [&](const map::KeyFrame* kf) { return kf && saved.count(kf->id()) > 0; };
