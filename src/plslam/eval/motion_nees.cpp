@@ -1,10 +1,9 @@
 #include "plslam/eval/motion_nees.h"
 
 #include <Eigen/Cholesky>
-#include <algorithm>
-#include <cmath>
 
 #include "plslam/eval/association.h"
+#include "plslam/eval/statistics.h"
 
 namespace plslam::eval {
 
@@ -44,12 +43,9 @@ MotionNees motion_nees(const Trajectory& ground_truth, const std::vector<Covaria
     if (e >= 0) out.nees.push_back(e);
   }
   if (!out.nees.empty()) {
-    double sum = 0;
-    for (double e : out.nees) sum += e;
-    out.mean = sum / static_cast<double>(out.nees.size());
-    std::vector<double> sorted = out.nees;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-    out.median = sorted[sorted.size() / 2];
+    const auto stats = compute_statistics(out.nees);
+    out.mean = stats.mean;
+    out.median = stats.median;
   }
   return out;
 }

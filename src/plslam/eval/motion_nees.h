@@ -22,7 +22,7 @@ struct CovariantPose {
 struct MotionNees {
   std::vector<double> nees;  // per motion scored, in order
   double mean = 0;           // of nees; 0 when none
-  double median = 0;
+  double median = 0;         // numpy's: the two middle values averaged (eval::compute_statistics)
   std::size_t dof = 6;
 };
 

@@ -91,9 +91,9 @@ void RunReport::add(const FrameResult& r) {
       r.track.keyframe ? (r.track.decision.insert ? tracking::to_string(d.reason) : "new-map") : "", r.track.point_inliers, r.track.line_inliers,
       in.reference_tracked, d.threshold, d.delta_pid, d.speed, in.tracked_close, in.untracked_close,
       r.track.local_keyframes, r.track.local_points, r.track.local_lines, r.extraction.stereo_points,
-      r.extraction.stereo_lines, r.tracking_ms, r.map_size.keyframes, r.map_size.points, r.map_size.lines, r.rss_mb)});
+      r.extraction.stereo_lines, r.tracking_ms, r.map_size.keyframes, r.map_size.points, r.map_size.lines, r.rss_mb),
+      r.track.pose_covariance});
   const auto& cov = r.track.pose_covariance;
-  frame_rows.back().covariance = cov;
   const bool has_cov = !cov.isZero(0);
   for (int a = 0; a < 6; ++a) {
     for (int b = a; b < 6; ++b) frame_rows.back().rest += has_cov ? fmt::format(",{:.4e}", cov(a, b)) : ",";
