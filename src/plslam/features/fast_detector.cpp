@@ -11,6 +11,7 @@
 
 #include "plslam/core/cpu_features.h"
 #include "plslam/core/error.h"
+#include "plslam/core/pixel_kernel.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -35,7 +36,7 @@ std::array<std::ptrdiff_t, 16> ring_offsets(std::ptrdiff_t step) {
 namespace scalar {
 
 // max over arcs of 9 of the min difference along the arc, brighter or darker.
-int raw_value(const uint8_t* p, const std::ptrdiff_t* ring) {
+[[gnu::always_inline]] inline int raw_value(const uint8_t* p, const std::ptrdiff_t* ring) {
   std::array<int, 16> bright{}, dark{};
   for (std::size_t k = 0; k < 16; ++k) {
     const int d = static_cast<int>(p[ring[k]]) - static_cast<int>(p[0]);
@@ -54,14 +55,14 @@ int raw_value(const uint8_t* p, const std::ptrdiff_t* ring) {
   return best;
 }
 
-void score_run(const uint8_t* p, const std::ptrdiff_t* ring, int n, uint8_t threshold, uint8_t* out) {
+PLSLAM_PIXEL_KERNEL void score_run(const uint8_t* p, const std::ptrdiff_t* ring, int n, uint8_t threshold, uint8_t* out) {
   for (int x = 0; x < n; ++x) {
     const int raw = raw_value(p + x, ring);
     out[x] = static_cast<uint8_t>(raw > threshold ? raw - 1 : 0);
   }
 }
 
-int nms_run(const uint8_t* s0, const uint8_t* s1, const uint8_t* s2, int x0, int x1, int* xs) {
+PLSLAM_PIXEL_KERNEL int nms_run(const uint8_t* s0, const uint8_t* s1, const uint8_t* s2, int x0, int x1, int* xs) {
   int n = 0;
   for (int x = x0; x < x1; ++x) {
     const uint8_t s = s1[x];
@@ -79,17 +80,17 @@ namespace sse2 {
 struct V {
   using T = __m128i;
   static constexpr int kLanes = 16;
-  static T load(const uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
-  static void store(uint8_t* p, T v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), v); }
-  static T set1(uint8_t v) { return _mm_set1_epi8(static_cast<char>(v)); }
-  static T subs(T a, T b) { return _mm_subs_epu8(a, b); }
-  static T sub(T a, T b) { return _mm_sub_epi8(a, b); }
-  static T min(T a, T b) { return _mm_min_epu8(a, b); }
-  static T max(T a, T b) { return _mm_max_epu8(a, b); }
-  static T eq_zero(T a) { return _mm_cmpeq_epi8(a, _mm_setzero_si128()); }
-  static T andnot(T a, T b) { return _mm_andnot_si128(a, b); }
-  static uint32_t nonzero_mask(T a) { return ~static_cast<uint32_t>(_mm_movemask_epi8(eq_zero(a))) & 0xFFFFu; }
-  static bool any_nonzero(T a) { return _mm_movemask_epi8(eq_zero(a)) != 0xFFFF; }
+  [[gnu::always_inline]] static T load(const uint8_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
+  [[gnu::always_inline]] static void store(uint8_t* p, T v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), v); }
+  [[gnu::always_inline]] static T set1(uint8_t v) { return _mm_set1_epi8(static_cast<char>(v)); }
+  [[gnu::always_inline]] static T subs(T a, T b) { return _mm_subs_epu8(a, b); }
+  [[gnu::always_inline]] static T sub(T a, T b) { return _mm_sub_epi8(a, b); }
+  [[gnu::always_inline]] static T min(T a, T b) { return _mm_min_epu8(a, b); }
+  [[gnu::always_inline]] static T max(T a, T b) { return _mm_max_epu8(a, b); }
+  [[gnu::always_inline]] static T eq_zero(T a) { return _mm_cmpeq_epi8(a, _mm_setzero_si128()); }
+  [[gnu::always_inline]] static T andnot(T a, T b) { return _mm_andnot_si128(a, b); }
+  [[gnu::always_inline]] static uint32_t nonzero_mask(T a) { return ~static_cast<uint32_t>(_mm_movemask_epi8(eq_zero(a))) & 0xFFFFu; }
+  [[gnu::always_inline]] static bool any_nonzero(T a) { return _mm_movemask_epi8(eq_zero(a)) != 0xFFFF; }
 };
 #include "plslam/features/fast_kernel.inc"
 }  // namespace sse2
@@ -106,17 +107,17 @@ namespace avx2 {
 struct V {
   using T = __m256i;
   static constexpr int kLanes = 32;
-  static T load(const uint8_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
-  static void store(uint8_t* p, T v) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), v); }
-  static T set1(uint8_t v) { return _mm256_set1_epi8(static_cast<char>(v)); }
-  static T subs(T a, T b) { return _mm256_subs_epu8(a, b); }
-  static T sub(T a, T b) { return _mm256_sub_epi8(a, b); }
-  static T min(T a, T b) { return _mm256_min_epu8(a, b); }
-  static T max(T a, T b) { return _mm256_max_epu8(a, b); }
-  static T eq_zero(T a) { return _mm256_cmpeq_epi8(a, _mm256_setzero_si256()); }
-  static T andnot(T a, T b) { return _mm256_andnot_si256(a, b); }
-  static uint32_t nonzero_mask(T a) { return ~static_cast<uint32_t>(_mm256_movemask_epi8(eq_zero(a))); }
-  static bool any_nonzero(T a) { return !_mm256_testz_si256(a, a); }
+  [[gnu::always_inline]] static T load(const uint8_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
+  [[gnu::always_inline]] static void store(uint8_t* p, T v) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), v); }
+  [[gnu::always_inline]] static T set1(uint8_t v) { return _mm256_set1_epi8(static_cast<char>(v)); }
+  [[gnu::always_inline]] static T subs(T a, T b) { return _mm256_subs_epu8(a, b); }
+  [[gnu::always_inline]] static T sub(T a, T b) { return _mm256_sub_epi8(a, b); }
+  [[gnu::always_inline]] static T min(T a, T b) { return _mm256_min_epu8(a, b); }
+  [[gnu::always_inline]] static T max(T a, T b) { return _mm256_max_epu8(a, b); }
+  [[gnu::always_inline]] static T eq_zero(T a) { return _mm256_cmpeq_epi8(a, _mm256_setzero_si256()); }
+  [[gnu::always_inline]] static T andnot(T a, T b) { return _mm256_andnot_si256(a, b); }
+  [[gnu::always_inline]] static uint32_t nonzero_mask(T a) { return ~static_cast<uint32_t>(_mm256_movemask_epi8(eq_zero(a))); }
+  [[gnu::always_inline]] static bool any_nonzero(T a) { return !_mm256_testz_si256(a, a); }
 };
 #include "plslam/features/fast_kernel.inc"
 }  // namespace avx2

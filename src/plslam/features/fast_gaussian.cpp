@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "plslam/core/cpu_features.h"
+#include "plslam/core/pixel_kernel.h"
 
 namespace plslam::features {
 namespace {
@@ -42,12 +43,12 @@ static_assert(k0 + 2 * (k1 + k2 + k3) == 256);
   }
 }
 
-void blur_baseline(const cv::Mat& src, const cv::Rect& rect, uint8_t* tmp, cv::Mat& dst) {
+PLSLAM_PIXEL_KERNEL void blur_baseline(const cv::Mat& src, const cv::Rect& rect, uint8_t* tmp, cv::Mat& dst) {
   blur_passes(src, rect, tmp, dst);
 }
 #if defined(__x86_64__)
 // Chosen with core::cpu_has_avx2().
-__attribute__((target("avx2"))) void blur_avx2(const cv::Mat& src, const cv::Rect& rect, uint8_t* tmp, cv::Mat& dst) {
+__attribute__((target("avx2"))) PLSLAM_PIXEL_KERNEL void blur_avx2(const cv::Mat& src, const cv::Rect& rect, uint8_t* tmp, cv::Mat& dst) {
   blur_passes(src, rect, tmp, dst);
 }
 #endif

@@ -7,6 +7,7 @@
 #include <opencv2/core/fast_math.hpp>
 
 #include "plslam/core/cpu_features.h"
+#include "plslam/core/pixel_kernel.h"
 
 namespace plslam::features {
 namespace {
@@ -140,15 +141,15 @@ namespace {
   }
 }
 
-float centroid_angle_baseline(const cv::Mat& image, int x, int y) { return centroid_angle_impl(image, x, y); }
-void brief_baseline(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
+PLSLAM_PIXEL_KERNEL float centroid_angle_baseline(const cv::Mat& image, int x, int y) { return centroid_angle_impl(image, x, y); }
+PLSLAM_PIXEL_KERNEL void brief_baseline(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
   brief_impl(blurred, x, y, angle_deg, out);
 }
 #if defined(__x86_64__)
-__attribute__((target("avx2"))) float centroid_angle_avx2(const cv::Mat& image, int x, int y) {
+__attribute__((target("avx2"))) PLSLAM_PIXEL_KERNEL float centroid_angle_avx2(const cv::Mat& image, int x, int y) {
   return centroid_angle_impl(image, x, y);
 }
-__attribute__((target("avx2"))) void brief_avx2(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
+__attribute__((target("avx2"))) PLSLAM_PIXEL_KERNEL void brief_avx2(const cv::Mat& blurred, int x, int y, float angle_deg, uint8_t* out) {
   brief_impl(blurred, x, y, angle_deg, out);
 }
 #endif
