@@ -106,8 +106,11 @@ if [ -n "$tests_regex" ]; then ctest_args+=(-R "$tests_regex"); fi
 # LoopClosingConcurrent.RenderedOfficeLoopClosesAtTheRevisitOnly runs the same threads on the same
 # scene, with loop closing and its global BA on top (109 s of the stage).
 # TimeRobustness.HighwayStartedOneFrameLateIsTrackedAtItsSpeed runs KITTI 01 (92 s under TSan);
-# the other TimeRobustness runs exercise the same prefetch thread on KITTI 06.
-TSAN_SKIP='^(RunConcurrent\.SyntheticOfficeWithLocalMappingThread|TimeRobustness\.HighwayStartedOneFrameLateIsTrackedAtItsSpeed)$'
+# the other TimeRobustness runs exercise the same prefetch thread on KITTI 06. Of those, the ones
+# that only drop or blank frames (SingleDroppedFrame, EverySecondFrameDropped, BlankImage: 70 s
+# under TSan) hand the prefetch thread nothing the others do not: files missing at the start and
+# the end, an unreadable image, a lost frame and a late start stay in the stage.
+TSAN_SKIP='^(RunConcurrent\.SyntheticOfficeWithLocalMappingThread|TimeRobustness\.(HighwayStartedOneFrameLateIsTrackedAtItsSpeed|SingleDroppedFrameKeepsTracking|EverySecondFrameDroppedKeepsTracking|BlankImageMidSequenceIsSkippedAndKeepsAlignment))$'
 if [ "$sanitize" = thread ]; then
   ctest_args+=(-E "$SANITIZER_SKIP|$TSAN_SKIP")
 elif [ -n "$sanitize" ]; then
