@@ -52,8 +52,15 @@ done
 #   BlackOut.*                                        a 480-frame office render and sequential runs of
 #                                                     180 and 346 frames; the same relocalization code
 #                                                     runs here in the kidnapped tests
-# (The CI run of 2026-11-26 took 56.7 of its 60 minutes; these two give back about 1.5.)
-SANITIZER_SKIP='^(RunEndToEnd\.(CorridorLinesLowerTheFrameToFrameError|Kitti01HighwayIsTrackedWithinBound|SyntheticStreetTurnIsTracked|SyntheticOfficeIsTrackedWithSmallError)|Relocalization\.KidnappedKittiCameraIsFoundAgainInTheSameMap|BlackOut\..*|RunDeterminism\.Sequential(Kitti|Rendered)RunsAreByteIdentical|LoopRun\.SequentialRunsWithALoopAreIdentical|BenchSlamCli\.QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequentialRunsDo|RunVideo\.ASyntheticVideoTracksLikeItsImageFolders)$'
+#   RunEndToEnd.Kitti06IsTrackedWithinBound           sequential KITTI 06 (43 s under ASan): the
+#                                                     kidnapped KITTI copies of Relocalization run the
+#                                                     same sequential path here, RunConcurrent KITTI 06
+#   BenchSlamCli.ConcurrentRunsAgreeWithASeparateRun... 4 concurrent runs compared as a spread (57 s
+#                                                     under ASan, where thread timing widens it); the
+#                                                     bench's runs and report run here in the SIGTERM test
+# (The CI run of 2026-11-26 took 56.7 of its 60 minutes; these two give back about 1.5. That of
+# 2026-11-29 took 65 minutes; the last two give back about 1.)
+SANITIZER_SKIP='^(RunEndToEnd\.(CorridorLinesLowerTheFrameToFrameError|Kitti01HighwayIsTrackedWithinBound|Kitti06IsTrackedWithinBound|SyntheticStreetTurnIsTracked|SyntheticOfficeIsTrackedWithSmallError)|Relocalization\.KidnappedKittiCameraIsFoundAgainInTheSameMap|BlackOut\..*|RunDeterminism\.Sequential(Kitti|Rendered)RunsAreByteIdentical|LoopRun\.SequentialRunsWithALoopAreIdentical|BenchSlamCli\.(QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequentialRunsDo|ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAnchorIsARow)|RunVideo\.ASyntheticVideoTracksLikeItsImageFolders)$'
 # ThreadSanitizer runs the tests whose code under test starts threads of plslam's own: the worker
 # pool and the BA that uses it, the local mapper's thread with its pause and abort
 # (LocalMapperThread), the map snapshot taken beside a writer (MapSnapshotConcurrent), the stereo extraction tasks, the image prefetch thread, synth's
