@@ -239,7 +239,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     const double gap = f.data->timestamp - last_->data->timestamp;
     if (tracked && !recovery_ && options_.recover_after_gap_s > 0 && gap > options_.recover_after_gap_s) {
       spdlog::info("frame {}: tracked after a {:.2f} s gap, recovering until confirmed", f.id(), gap);
-      recovery_ = Recovery{f.id(), 0, f.T_cw, true};
+      recovery_ = Recovery{f.id(), 0, f.T_cw, true, trusted_since_recovery_};
       trusted_since_recovery_ = false;
     }
     if (tracked && recovery_ && !recovery_holds(f, jumped)) {
@@ -247,6 +247,10 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
                    recovery_->after_gap ? "tracking after the gap" : "relocalization", recovery_->since_frame,
                    recovery_->frames);
       if (!recovery_->after_gap) refuted_relocalizations_.push_back(recovery_->since_frame);
+      // Refuted on its own first frame, the tracking across the gap put no pose into the motion
+      // model: a relocalization of this frame that lands on the prediction from the last trusted
+      // frame still continues the trusted trajectory (continuity_s).
+      if (recovery_->frames == 0) trusted_since_recovery_ = recovery_->trusted_before;
       tracked = false;
     }
     if (tracked) {

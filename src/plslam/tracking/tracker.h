@@ -331,6 +331,7 @@ class Tracker {
     int frames = 0;
     geometry::SE3 T_cw;  // the relocalized pose
     bool after_gap = false;  // started by tracking across a gap, not by a relocalization
+    bool trusted_before = false;  // trusted_since_recovery_ when it started
   };
   // Whether the recovery has seen enough (RelocalizationOptions::confirm_*) with `f` tracked.
   bool recovery_confirmed(const Frame& f) const;
