@@ -290,6 +290,11 @@ std::vector<ConfigKey> make_table() {
           "while recovering: share of the image cells showing local map points that must hold inliers (a "
           "look-alike matches only the repeated object; 0: no check)",
           in_closed(0, 1)),
+    field("relocalization", "max_cell_misses",
+          [](auto& o) -> auto& { return o.tracker.relocalization.max_cell_misses; },
+          "recovering frames under min_cell_coverage that are forgiven, each after two frames that held it and "
+          "for one more such frame before the confirmation (0: every one refutes)",
+          at_least(0)),
     field("relocalization", "continuity_s",
           [](auto& o) -> auto& { return o.tracker.relocalization.continuity_s; },
           "a relocalization this soon after the last trusted frame that lands where the motion model puts it "

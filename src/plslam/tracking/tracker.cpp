@@ -149,16 +149,20 @@ bool Tracker::beyond_reach(const Frame& f) {
   return true;
 }
 
-bool Tracker::recovery_holds(const Frame& f, bool jumped) const {
-  if (jumped) return false;
+Tracker::RecoveryCheck Tracker::check_recovery(const Frame& f, bool jumped) const {
+  if (jumped) return RecoveryCheck::kRefuted;
+  const auto& o = options_.relocalization;
   const auto e = explained(f, local_points_);
-  const double min_coverage = options_.relocalization.min_cell_coverage;
-  const auto coverage = min_coverage > 0 ? cell_coverage(f, local_points_) : CellCoverage{};
+  const auto coverage = o.min_cell_coverage > 0 ? cell_coverage(f, local_points_) : CellCoverage{};
   spdlog::debug("frame {}: recovering ({} of {} frames): {} of {} visible local map points matched, inliers in {} "
                 "of {} cells",
-                f.id(), recovery_->frames + 1, options_.relocalization.confirm_frames, e.matched, e.visible,
+                f.id(), recovery_->frames + 1, o.confirm_frames + recovery_->cell_misses, e.matched, e.visible,
                 coverage.covered, coverage.predicted);
-  return e.enough && (min_coverage <= 0 || coverage.share() >= min_coverage);
+  if (!e.enough) return RecoveryCheck::kRefuted;
+  if (o.min_cell_coverage <= 0 || coverage.share() >= o.min_cell_coverage) return RecoveryCheck::kHolds;
+  // A look-alike fails most of its frames; a true place may dip once after holding twice.
+  const bool forgiven = recovery_->cell_misses < o.max_cell_misses && recovery_->passed >= 2;
+  return forgiven ? RecoveryCheck::kCellMiss : RecoveryCheck::kRefuted;
 }
 
 Tracker::Explained Tracker::explained(const Frame& f, const std::vector<map::MapPoint*>& points) const {
@@ -242,7 +246,13 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       recovery_ = Recovery{f.id(), 0, f.T_cw, true, trusted_since_recovery_};
       trusted_since_recovery_ = false;
     }
-    if (tracked && recovery_ && !recovery_holds(f, jumped)) {
+    const auto check = tracked && recovery_ ? check_recovery(f, jumped) : RecoveryCheck::kHolds;
+    if (check == RecoveryCheck::kCellMiss) {
+      ++recovery_->cell_misses;
+      spdlog::info("frame {}: recovering from frame {} with inliers in too few image cells (miss {} of {} forgiven)",
+                   f.id(), recovery_->since_frame, recovery_->cell_misses, options_.relocalization.max_cell_misses);
+    }
+    if (tracked && check == RecoveryCheck::kRefuted) {
       spdlog::warn("frame {}: the {} of frame {} is refuted after {} frames", f.id(),
                    recovery_->after_gap ? "tracking after the gap" : "relocalization", recovery_->since_frame,
                    recovery_->frames);
@@ -257,8 +267,9 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       ok = true;
       velocity_ = (f.T_cw * last_->T_cw.inverse()).normalized();
       velocity_dt_ = f.data->timestamp - last_->data->timestamp;
-      if (recovery_) {
+      if (recovery_ && check == RecoveryCheck::kHolds) {
         ++recovery_->frames;
+        ++recovery_->passed;
         if (recovery_confirmed(f)) confirm_relocalization(f, result);
       }
       finish_tracked_frame(f, result);
@@ -357,7 +368,8 @@ bool Tracker::continues_trusted_motion(const Frame& f) const {
 
 bool Tracker::recovery_confirmed(const Frame& f) const {
   const auto& o = options_.relocalization;
-  if (recovery_->frames < o.confirm_frames) return false;
+  // Each forgiven miss asks one more frame that holds.
+  if (recovery_->frames < o.confirm_frames + recovery_->cell_misses) return false;
   if (o.confirm_distance_m <= 0 && o.confirm_angle_deg <= 0) return true;
   const auto gap = pose_gap(f.T_cw, recovery_->T_cw);
   return (o.confirm_distance_m > 0 && gap.m >= o.confirm_distance_m) ||
