@@ -4,7 +4,8 @@
 #   scripts/test.sh                              Release build in build/, the whole suite
 #   scripts/test.sh --sanitize address,undefined ASan+UBSan build in build-asan/, the whole suite
 #   scripts/test.sh --sanitize thread            TSan build in build-tsan/, the threaded tests
-#   scripts/test.sh --sanitize thread --tests R  ... only the tests whose name matches regex R
+#   scripts/test.sh --sanitize thread --tests R  ... only the ctest tests whose name matches regex R
+#     (ctest names: the tests of tests/test_lists.cmake one by one, every other suite as "Suite.*")
 #
 # Other arguments go to CMake (e.g. -DPLSLAM_SHARED_DIR=...). BUILD_DIR overrides the build folder.
 # A sanitizer build is -O1 -g1 with frame pointers (cmake/Sanitizers.cmake) and every test process
@@ -26,49 +27,9 @@ while [ $# -gt 0 ]; do
   esac
 done
 
-# Under the sanitizers, the named long accuracy runs are left out: they run the same code as the
-# shorter end-to-end runs, only longer, and their ATE bounds are checked by the Release stage.
-#   RunEndToEnd.CorridorLinesLowerTheFrameToFrameError  6 corridor runs (300 s under ASan)
-#   RunEndToEnd.Kitti01HighwayIsTrackedWithinBound      KITTI 01, the same path as KITTI 06
-#   RunEndToEnd.SyntheticStreetTurnIsTracked            a rendered street at KITTI size (120 s under
-#                                                     ASan); KITTI 06 and the kidnapped KITTI copies
-#                                                     run the same sequential path here
-#   RunDeterminism.Sequential*RunsAreByteIdentical  each runs plslam twice to compare the bytes;
-#                                                     the same code as RunEndToEnd, which runs here
-#   LoopRun.SequentialRunsWithALoopAreIdentical      likewise, with loop closing; the loop itself
-#                                                     runs here in LoopClosingConcurrent
-#   BenchSlamCli.QuickPreset...                       8 sequential runs of one office render (230 s
-#                                                     under ASan); the bench's own code runs here in
-#                                                     the other BenchSlamCli tests
-#   RunVideo.ASyntheticVideoTracksLikeItsImageFolders two 120-frame sequential runs (160 s under
-#                                                     ASan); video decoding runs here in
-#                                                     RunVideo.AVideoPlayedAsACamera... and VideoDataset
-#   RunEndToEnd.SyntheticOfficeIsTrackedWithSmallError the rendered office, sequential (80 s under
-#                                                     ASan); RunConcurrent and LoopClosingConcurrent
-#                                                     run the same scene here with every thread
-#   Relocalization.KidnappedKittiCameraIsFoundAgainInTheSameMap  sequential (100 s under ASan);
-#                                                     RelocalizationConcurrent runs the same kidnapping
-#                                                     here, with local mapping's thread
-#   BlackOut.*                                        a 480-frame office render and sequential runs of
-#                                                     180 and 346 frames; the same relocalization code
-#                                                     runs here in the kidnapped tests
-#   RunEndToEnd.Kitti06IsTrackedWithinBound           sequential KITTI 06 (43 s under ASan): the
-#                                                     kidnapped KITTI copies of Relocalization run the
-#                                                     same sequential path here, RunConcurrent KITTI 06
-#   BenchSlamCli.ConcurrentRunsAgreeWithASeparateRun... 4 concurrent runs compared as a spread (57 s
-#                                                     under ASan, where thread timing widens it); the
-#                                                     bench's runs and report run here in the SIGTERM test
-#   TimeRobustness.HighwayStartedOneFrameLate...      KITTI 01 (26 s under ASan, 92 s under TSan), the
-#                                                     same path as the KITTI 06 copies of the others
-#   TimeRobustness.{SingleDroppedFrame,EverySecondFrameDropped}KeepsTracking,
-#   TimeRobustness.BlankImageMidSequence...           frames dropped or blanked (37 s under ASan, 70 s
-#                                                     under TSan): files missing at the start and the
-#                                                     end, an unreadable image, a lost frame and a late
-#                                                     start run here, through the same reader and
-#                                                     prefetch thread
-# (The CI run of 2026-11-26 took 56.7 of its 60 minutes; these two give back about 1.5. That of
-# 2026-11-29 took 65 minutes; the last four give back about 2.)
-SANITIZER_SKIP='^(RunEndToEnd\.(CorridorLinesLowerTheFrameToFrameError|Kitti01HighwayIsTrackedWithinBound|Kitti06IsTrackedWithinBound|SyntheticStreetTurnIsTracked|SyntheticOfficeIsTrackedWithSmallError)|Relocalization\.KidnappedKittiCameraIsFoundAgainInTheSameMap|BlackOut\..*|RunDeterminism\.Sequential(Kitti|Rendered)RunsAreByteIdentical|LoopRun\.SequentialRunsWithALoopAreIdentical|BenchSlamCli\.(QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequentialRunsDo|ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAnchorIsARow)|RunVideo\.ASyntheticVideoTracksLikeItsImageFolders|TimeRobustness\.(HighwayStartedOneFrameLateIsTrackedAtItsSpeed|SingleDroppedFrameKeepsTracking|EverySecondFrameDroppedKeepsTracking|BlankImageMidSequenceIsSkippedAndKeepsAlignment))$'
+# Under the sanitizers, the long accuracy runs labelled sanitizer_skip in tests/test_lists.cmake are
+# left out (each entry says why, and which test runs its code instead); the ThreadSanitizer stage
+# also leaves out those labelled tsan_skip.
 # ThreadSanitizer runs the tests whose code under test starts threads of plslam's own: the worker
 # pool and the BA that uses it, the local mapper's thread with its pause and abort
 # (LocalMapperThread), the map snapshot taken beside a writer (MapSnapshotConcurrent), the stereo extraction tasks, the image prefetch thread, synth's
@@ -117,14 +78,9 @@ cmake --build "$BUILD_DIR" -j"$(nproc)" ${build_targets[@]+"${build_targets[@]}"
 ctest_args=(--test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)")
 if [ -z "$tests_regex" ] && [ "$sanitize" = thread ]; then tests_regex=$TSAN_TESTS; fi
 if [ -n "$tests_regex" ]; then ctest_args+=(-R "$tests_regex"); fi
-# Under ThreadSanitizer the rendered office run of RunConcurrent is left out as well:
-# LoopClosingConcurrent.RenderedOfficeLoopClosesAtTheRevisitOnly runs the same threads on the same
-# scene, with loop closing and its global BA on top (109 s of the stage).
-# (The TimeRobustness runs it leaves out are in SANITIZER_SKIP above.)
-TSAN_SKIP='^(RunConcurrent\.SyntheticOfficeWithLocalMappingThread)$'
 if [ "$sanitize" = thread ]; then
-  ctest_args+=(-E "$SANITIZER_SKIP|$TSAN_SKIP")
+  ctest_args+=(-LE 'sanitizer_skip|tsan_skip')
 elif [ -n "$sanitize" ]; then
-  ctest_args+=(-E "$SANITIZER_SKIP")
+  ctest_args+=(-LE sanitizer_skip)
 fi
 ctest "${ctest_args[@]}"
