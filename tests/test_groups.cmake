@@ -1,7 +1,8 @@
 # Defines the tests of one GoogleTest executable for ctest, at ctest time (TEST_INCLUDE_FILES, set
 # up by tests/CMakeLists.txt with _plslam_exe, _plslam_dir and _plslam_cache). The tests named in
-# tests/test_lists.cmake run one by one, under their own names, with their COST and LABELS; every
-# other suite runs as one test, "Suite.*", whose tests share one process.
+# tests/test_lists.cmake (plslam_test) run one by one, under their own names, with their COST and
+# LABELS (and their suite's labels); the other tests of each suite run as one test, "Suite.*", in one
+# process, with the suite's COST and LABELS where it is listed (plslam_suite).
 #
 # Why: each process of a test executable loads ~270 shared libraries (OpenCV's image codecs and
 # video I/O bring GDAL, GDCM, FFmpeg, ...). An executable that runs no test takes 0.23 s in
@@ -29,7 +30,9 @@ if(NOT EXISTS "${_plslam_cache}" OR "${_plslam_exe}" IS_NEWER_THAN "${_plslam_ca
     set(_labels_${name} "${a_LABELS}" PARENT_SCOPE)
   endfunction()
   function(plslam_suite suite)
-    cmake_parse_arguments(PARSE_ARGV 1 a "" "" "LABELS")
+    cmake_parse_arguments(PARSE_ARGV 1 a "" "COST" "LABELS")
+    set(_suite_listed_${suite} TRUE PARENT_SCOPE)
+    set(_suite_cost_${suite} "${a_COST}" PARENT_SCOPE)
     set(_suite_labels_${suite} "${a_LABELS}" PARENT_SCOPE)
   endfunction()
   include(${_plslam_lists})
@@ -52,7 +55,7 @@ if(NOT EXISTS "${_plslam_cache}" OR "${_plslam_exe}" IS_NEWER_THAN "${_plslam_ca
     elseif(_line MATCHES "^  ")  # "  Test" or "  Test/0  # GetParam() = ..."
       string(REGEX REPLACE "^ +([^ ]+).*$" "\\1" _test "${_line}")
       set(_name "${_suite}.${_test}")
-      if(_solo_${_name} OR DEFINED _suite_labels_${_suite})
+      if(_solo_${_name})
         set(_props "TIMEOUT 900 SKIP_REGULAR_EXPRESSION \"\\\\[  SKIPPED \\\\]\"")
         set(_labels ${_labels_${_name}} ${_suite_labels_${_suite}})
         if(_labels)
@@ -76,10 +79,21 @@ if(NOT EXISTS "${_plslam_cache}" OR "${_plslam_exe}" IS_NEWER_THAN "${_plslam_ca
       continue()
     endif()
     list(JOIN _members_${_suite} ":" _filter)
-    # A suite's tests pass or fail together; the output names the failing ones.
+    # A suite's tests pass or fail together; the output names the failing ones. A suite in the lists
+    # (plslam_suite) has its cost and labels.
+    set(_props "TIMEOUT 900")
+    if(_suite_labels_${_suite})
+      string(APPEND _props " LABELS \"${_suite_labels_${_suite}}\"")
+    endif()
+    if(_suite_cost_${_suite})
+      string(APPEND _props " COST ${_suite_cost_${_suite}}")
+    endif()
     string(APPEND _script "add_test([==[${_suite}.*]==] \"${_plslam_exe}\" [==[--gtest_filter=${_filter}]==])\n"
-                          "set_tests_properties([==[${_suite}.*]==] PROPERTIES WORKING_DIRECTORY \"${_plslam_dir}\" TIMEOUT 900)\n"
+                          "set_tests_properties([==[${_suite}.*]==] PROPERTIES WORKING_DIRECTORY \"${_plslam_dir}\" ${_props})\n"
                           "list(APPEND _plslam_defined [==[${_suite}.*]==])\n")
+    if(_suite_listed_${_suite})
+      string(APPEND _script "list(APPEND _plslam_suites_found [==[${_suite}]==])\n")
+    endif()
   endforeach()
   file(WRITE "${_plslam_cache}" "${_script}")
 endif()
