@@ -3,13 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "plslam/core/stopwatch.h"
 #include "plslam/core/thread_priority.h"
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/optim/pose_only.h"
+#include "plslam/place/bow_vector.h"
 
 namespace plslam::loop {
 namespace {
@@ -34,6 +38,7 @@ class MapperPause {
 void LoopClosingOptions::validate() const {
   detector.validate();
   verifier.validate();
+  across_verifier.validate();
   correction.graph.validate();
   if (min_projection_inliers < verifier.min_inliers) {
     throw std::invalid_argument("loop.min_projection_inliers: must be >= loop.min_inliers");
@@ -80,8 +85,10 @@ void LoopCloser::insert(map::KeyFrame* kf) {
   cv_.notify_all();
 }
 
-void LoopCloser::global_ba_after_keyframe(long keyframe_id) {
-  if (options_.global_ba && options_.global_ba_after_relocalization) revisit_keyframe_ = keyframe_id;
+void LoopCloser::global_ba_after_keyframe(long keyframe_id, long before_loss_keyframe_id) {
+  if (!options_.global_ba || !options_.global_ba_after_relocalization) return;
+  revisit_from_ = options_.loop_across_relocalization ? before_loss_keyframe_id : -1;
+  revisit_keyframe_ = keyframe_id;
 }
 
 bool LoopCloser::try_pause() {
@@ -203,8 +210,9 @@ void LoopCloser::run() {
   }
 }
 
-std::optional<LoopConstraint> LoopCloser::confirm(map::KeyFrame* kf, const LoopDetection& d) {
-  auto c = verify_loop(kf, d.keyframe, database_, options_.verifier);
+std::optional<LoopConstraint> LoopCloser::confirm(map::KeyFrame* kf, const LoopDetection& d,
+                                                  const LoopVerifierOptions& verifier, long path_from) {
+  auto c = verify_loop(kf, d.keyframe, database_, verifier);
   if (!c) return std::nullopt;
   // The place's map points, projected into the keyframe with the verified pose, give more
   // matches; the keyframe's pose refined over all their reprojection errors must keep enough.
@@ -245,7 +253,11 @@ std::optional<LoopConstraint> LoopCloser::confirm(map::KeyFrame* kf, const LoopD
     terms.push_back({matched[i]->position(), qd.point_observation(i)});
     term_keypoint.push_back(i);
   }
-  if (static_cast<int>(terms.size()) < options_.min_projection_inliers) return std::nullopt;
+  if (static_cast<int>(terms.size()) < options_.min_projection_inliers) {
+    spdlog::debug("loop: keyframe {} -> {}: {} matches after the projection search, rejected", kf->id(),
+                  d.keyframe->id(), terms.size());
+    return std::nullopt;
+  }
   optim::PoseOnlyOptions po;
   po.scale_factor = qd.scale_factor;
   const auto refined = optim::optimize_pose(geometry::StereoCamera(qd.calib), T_qw, terms, {}, po);
@@ -255,7 +267,7 @@ std::optional<LoopConstraint> LoopCloser::confirm(map::KeyFrame* kf, const LoopD
     return std::nullopt;
   }
   c->T_query_candidate = (refined.T_cw * T_cw.inverse()).normalized();
-  if (!plausible(kf, d.keyframe, refined.T_cw)) return std::nullopt;
+  if (!plausible(kf, d.keyframe, refined.T_cw, path_from >= 0 ? path_from : d.keyframe->id())) return std::nullopt;
   // The matches to fuse: the refinement's inliers whose keypoint already has a map point.
   const auto q_points = kf->map_points();
   c->matches.clear();
@@ -268,12 +280,13 @@ std::optional<LoopConstraint> LoopCloser::confirm(map::KeyFrame* kf, const LoopD
   return c;
 }
 
-bool LoopCloser::plausible(map::KeyFrame* query, map::KeyFrame* candidate, const geometry::SE3& T_qw_corrected) {
+bool LoopCloser::plausible(map::KeyFrame* query, map::KeyFrame* candidate, const geometry::SE3& T_qw_corrected,
+                           long path_from) {
   // The path the keyframes travelled from the place to the query, in keyframe order.
   double path = 0;
   const map::KeyFrame* previous = nullptr;
   for (map::KeyFrame* k : map_.keyframes()) {
-    if (k->id() < candidate->id() || k->id() > query->id()) continue;
+    if (k->id() < path_from || k->id() > query->id()) continue;
     if (previous) path += (k->camera_center() - previous->camera_center()).norm();
     previous = k;
   }
@@ -299,6 +312,8 @@ void LoopCloser::process(map::KeyFrame* kf) {
   // keyframe.
   if (!revisit_keyframe_.compare_exchange_strong(revisit, -1)) return;
   if (loop_closed) return;  // the loop started its own global BA
+  const long before = revisit_from_.exchange(-1);
+  if (before >= 0 && close_loop_across_relocalization(kf, before)) return;
   spdlog::info("global BA after the relocalized revisit: keyframe {} (frame {})", kf->id(), kf->frame_id());
   {
     std::lock_guard lock(stats_mutex_);
@@ -332,7 +347,7 @@ bool LoopCloser::close_loop(map::KeyFrame* kf) {
     if (std::any_of(group.begin(), group.end(), [&](map::KeyFrame* g) { return neighbourhood.count(g) > 0; })) {
       continue;
     }
-    loop = confirm(kf, d);
+    loop = confirm(kf, d, options_.verifier);
     if (loop) break;
     ++rejected;
   }
@@ -342,24 +357,94 @@ bool LoopCloser::close_loop(map::KeyFrame* kf) {
     stats_.rejected += rejected;
   }
   if (!loop) return false;
+  correct(*loop, kf);
+  return true;
+}
+
+// Keyframes of the revisit's place verified against the one before the loss, most similar first.
+constexpr std::size_t kAcrossRelocalizationCandidates = 3;
+
+bool LoopCloser::close_loop_across_relocalization(map::KeyFrame* kf, long before_id) {
+  map::KeyFrame* before = nullptr;
+  for (map::KeyFrame* k : map_.keyframes()) {
+    if (k->id() == before_id) before = k;
+  }
+  if (!before || before->is_bad() || kf->is_bad()) return false;
+  MapperPause pause(mapper_);
+  if (before->is_bad() || kf->is_bad()) return false;
+  // A relocalization that continued the trusted trajectory left the two in one neighbourhood.
+  map::IdSet<map::KeyFrame> neighbourhood;
+  neighbourhood.insert(before);
+  for (map::KeyFrame* n : before->covisibles()) neighbourhood.insert(n);
+  const auto group = kf->covisibles();
+  if (neighbourhood.count(kf) ||
+      std::any_of(group.begin(), group.end(), [&](map::KeyFrame* g) { return neighbourhood.count(g) > 0; })) {
+    return false;
+  }
+  // The drift to correct is that of the path since the place was seen: from the oldest keyframe
+  // of the revisit's neighbourhood (where relocalization put the camera) to the one before the loss.
+  long place = kf->id();
+  for (map::KeyFrame* g : group) place = std::min(place, g->id());
+  // The candidates: the revisit's keyframe and its neighbourhood, the most similar to the keyframe
+  // before the loss first (the camera moved on during the loss, so another view of the place may
+  // overlap it more).
+  const auto description = database_.description(before);
+  if (!description) return false;
+  std::vector<std::pair<double, map::KeyFrame*>> candidates;
+  for (map::KeyFrame* c : [&] {
+         auto v = group;
+         v.insert(v.begin(), kf);
+         return v;
+       }()) {
+    const auto d = database_.description(c);
+    if (!d || c->is_bad() || neighbourhood.count(c)) continue;
+    candidates.emplace_back(place::l1_score(description->bow, d->bow), c);
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  if (candidates.size() > kAcrossRelocalizationCandidates) candidates.resize(kAcrossRelocalizationCandidates);
+  std::optional<LoopConstraint> loop;
+  for (const auto& [score, c] : candidates) {
+    loop = confirm(before, LoopDetection{c, score, 0}, options_.across_verifier, place);
+    if (loop) break;
+  }
+  {
+    std::lock_guard lock(stats_mutex_);
+    stats_.detections += static_cast<int>(candidates.size());
+    stats_.rejected += static_cast<int>(candidates.size()) - (loop ? 1 : 0);
+  }
+  spdlog::info("loop across the relocalization: keyframe {} (frame {}, before the loss) -> {}", before->id(),
+               before->frame_id(),
+               loop ? fmt::format("keyframe {} (frame {}) verified", loop->candidate->id(), loop->candidate->frame_id())
+                    : fmt::format("none of {} keyframes of the revisit's place verified", candidates.size()));
+  if (!loop) return false;
+  {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.loops_across_relocalization;
+  }
+  correct(*loop, kf);
+  return true;
+}
+
+void LoopCloser::correct(const LoopConstraint& loop, map::KeyFrame* newest) {
+  map::KeyFrame* kf = loop.query;
   abort_global_ba();  // its snapshot predates this loop
   const auto t0 = std::chrono::steady_clock::now();
   LoopCorrectionResult corrected;
   {
     std::lock_guard map_lock(map_.update_mutex());
-    corrected = correct_loop(map_, *loop, options_.correction);
+    corrected = correct_loop(map_, loop, options_.correction);
     // A loop into an anchored segment brings a new segment's keyframes into the map's frame.
-    map_.tie_segments(kf->segment(), loop->candidate->segment());
+    map_.tie_segments(kf->segment(), loop.candidate->segment());
   }
   const double ms = ms_since(t0);
   detector_.reset();
-  last_loop_keyframe_ = kf->id();
+  last_loop_keyframe_ = std::max(kf->id(), newest->id());
   LoopRecord rec;
   rec.frame = kf->frame_id();
   rec.keyframe = kf->id();
-  rec.matched_keyframe = loop->candidate->id();
-  rec.matched_frame = loop->candidate->frame_id();
-  rec.inliers = loop->inliers;
+  rec.matched_keyframe = loop.candidate->id();
+  rec.matched_frame = loop.candidate->frame_id();
+  rec.inliers = loop.inliers;
   rec.fused_points = corrected.fused_points;
   rec.fused_lines = corrected.fused_lines;
   rec.correction_ms = ms;
@@ -372,7 +457,6 @@ bool LoopCloser::close_loop(map::KeyFrame* kf) {
     stats_.loops.push_back(rec);
   }
   if (options_.global_ba) start_global_ba();
-  return true;
 }
 
 void LoopCloser::start_global_ba() {

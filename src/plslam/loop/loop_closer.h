@@ -44,6 +44,22 @@ struct LoopClosingOptions {
   // keyframes to it, so without this the revisit's keyframes never meet the first pass's in one
   // optimisation. Needs global_ba.
   bool global_ba_after_relocalization = true;
+  // ... and before it, a loop across the loss: the last keyframe tracking made before it, verified
+  // against the revisit's first keyframe and its place like a detected loop (SE(3), projection,
+  // plausibility over the path since the place). When the loss hid the moment a loop would have been
+  // detected (a black-out as the camera comes back to the start), the relocalization ties the
+  // revisit to the place, but only this ties the drifted end of the path to it.
+  bool loop_across_relocalization = true;
+  // Its first check asks less than a detected loop's (verifier): the relocalization already put the
+  // camera at the place, and the keyframe before the loss sees it only at the edge of its view (16-17
+  // BoW matches on the office loop, where the projection check then kept 122 inliers). The
+  // projection check and the plausibility bound are those of any loop.
+  LoopVerifierOptions across_verifier = [] {
+    LoopVerifierOptions v;
+    v.min_matches = 12;
+    v.min_inliers = 10;
+    return v;
+  }();
   GlobalBaOptions global_ba_options;
   // At the end of a run, how long finish() waits for a running global BA before aborting it.
   double finish_wait_s = 120;
@@ -71,6 +87,7 @@ struct LoopClosingStats {
   int global_ba_runs = 0;            // merged
   int global_ba_aborted = 0;         // made obsolete by a newer loop, or cut at finish()
   int global_ba_after_relocalization = 0;  // started for a relocalized revisit (no loop)
+  int loops_across_relocalization = 0;     // of the loops, those closed across a relocalization
 };
 
 class LoopCloser {
@@ -88,7 +105,9 @@ class LoopCloser {
   // Tracking relocalized in the same map after a loss, and keyframe `keyframe_id` is the first it
   // made since: once that keyframe (or a later one, if it was culled) has been mapped and passed
   // through loop detection without a loop, a global BA runs (global_ba_after_relocalization).
-  void global_ba_after_keyframe(long keyframe_id);
+  // `before_loss_keyframe_id`: the reference keyframe of the last trusted frame before the loss, for
+  // loop_across_relocalization (-1: none).
+  void global_ba_after_keyframe(long keyframe_id, long before_loss_keyframe_id = -1);
   // Processes every queued keyframe in the calling thread (sequential mode and tests).
   void process_pending();
   void wait_idle();
@@ -108,10 +127,18 @@ class LoopCloser {
   bool close_loop(map::KeyFrame* kf);
   // Global BA in its own thread (in the caller's in sequential mode).
   void start_global_ba();
+  // The loop across a relocalization (loop_across_relocalization): `before` is the query, the
+  // revisit's keyframe `kf` the place. True if a loop was closed.
+  bool close_loop_across_relocalization(map::KeyFrame* kf, long before_id);
+  // Correction, records and global BA of a confirmed loop; `newest` is the latest keyframe involved.
+  void correct(const LoopConstraint& loop, map::KeyFrame* newest);
   // Verification and the projection check; the constraint to correct with, if the place holds.
-  std::optional<LoopConstraint> confirm(map::KeyFrame* kf, const LoopDetection& d);
-  // Whether moving the query to T_qw_corrected is within what odometry drift can explain.
-  bool plausible(map::KeyFrame* query, map::KeyFrame* candidate, const geometry::SE3& T_qw_corrected);
+  // `path_from`: the keyframe id the drift is counted from (-1: the candidate's).
+  std::optional<LoopConstraint> confirm(map::KeyFrame* kf, const LoopDetection& d, const LoopVerifierOptions& verifier,
+                                       long path_from = -1);
+  // Whether moving the query to T_qw_corrected is within what odometry drift can explain over the
+  // path from keyframe `path_from` to the query.
+  bool plausible(map::KeyFrame* query, map::KeyFrame* candidate, const geometry::SE3& T_qw_corrected, long path_from);
   // Snapshot, optimise, merge (unless aborted).
   void global_ba();
   void abort_global_ba();
@@ -123,6 +150,7 @@ class LoopCloser {
   LoopDetector detector_;
   long last_loop_keyframe_ = -1;
   std::atomic<long> revisit_keyframe_{-1};  // global_ba_after_keyframe()'s id, until served
+  std::atomic<long> revisit_from_{-1};      // ... and the keyframe before the loss
 
   mutable std::mutex queue_mutex_;
   std::condition_variable cv_;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include <Eigen/Core>
+#include <spdlog/spdlog.h>
 
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/geometry/umeyama.h"
@@ -81,7 +82,11 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
     pairs.push_back({qp, cp, Tq * qp->position(), Tc * cp->position(), {qk.pt.x, qk.pt.y}, {ck.pt.x, ck.pt.y},
                      qs * qs, cs * cs, static_cast<std::size_t>(m.query)});
   }
-  if (static_cast<int>(pairs.size()) < o.min_matches) return std::nullopt;
+  if (static_cast<int>(pairs.size()) < o.min_matches) {
+    spdlog::debug("loop verification {} -> {}: {} BoW matches between map points, {} needed", query->id(),
+                  candidate->id(), pairs.size(), o.min_matches);
+    return std::nullopt;
+  }
   // 2. RANSAC over minimal 3-point alignments.
   const geometry::StereoCamera qcam(qdata.calib), ccam(cdata.calib);
   std::mt19937 rng(o.seed);
@@ -111,7 +116,11 @@ std::optional<LoopConstraint> verify_loop(map::KeyFrame* query, map::KeyFrame* c
       T = H;
     }
   }
-  if (static_cast<int>(best.size()) < o.min_inliers) return std::nullopt;
+  if (static_cast<int>(best.size()) < o.min_inliers) {
+    spdlog::debug("loop verification {} -> {}: {} of {} matches agree in SE(3), {} needed", query->id(),
+                  candidate->id(), best.size(), pairs.size(), o.min_inliers);
+    return std::nullopt;
+  }
   // 3. Refine over pixel errors: the candidate's points, in its camera frame, seen by the query's
   // keypoints (left pixel and right column), until the inliers stop changing. A 3D fit would let far
   // points, whose depths are loose, pull the pose: an unweighted Umeyama refit once slid a street

@@ -338,6 +338,10 @@ std::vector<ConfigKey> make_table() {
     field("loop", "global_ba_after_relocalization",
           [](auto& o) -> auto& { return o.loop.global_ba_after_relocalization; },
           "also after tracking relocalized in the same map after a loss (a revisit no loop is closed for)"),
+    field("loop", "across_relocalization",
+          [](auto& o) -> auto& { return o.loop.loop_across_relocalization; },
+          "before that global BA, verify a loop from the last keyframe before the loss to the revisit's first "
+          "(a loss that hid the loop's detection); needs global_ba_after_relocalization"),
     field("loop", "global_ba_iterations", [](auto& o) -> auto& { return o.loop.global_ba_options.iterations; },
           "global BA iterations (per pass)"),
     field("loop", "global_ba_remove_outliers", [](auto& o) -> auto& { return o.loop.global_ba_options.remove_outliers; },

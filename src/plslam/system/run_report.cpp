@@ -39,7 +39,8 @@ nlohmann::json loop_closing_json(const System& slam) {
   if (!slam.loop_closer()) return {{"enabled", false}};
   const auto s = slam.loop_closer()->stats();
   return {{"enabled", true}, {"detections", s.detections}, {"rejected", s.rejected}, {"implausible", s.implausible},
-          {"global_ba_after_relocalization", s.global_ba_after_relocalization}};
+          {"global_ba_after_relocalization", s.global_ba_after_relocalization},
+          {"loops_across_relocalization", s.loops_across_relocalization}};
 }
 
 nlohmann::json global_ba_ms(const System& slam) {

@@ -80,6 +80,7 @@ System::System(const StereoCalibration& calib, SystemOptions options, std::share
   mapper_->set_keyframe_database(database_.get());
   if (database_ && options_.loop_closing) {
     options_.loop.verifier.seed = options_.seed;
+    options_.loop.across_verifier.seed = options_.seed;
     options_.loop.correction.lines = options_.mapper.lines;
     options_.loop.global_ba_options.lines = options_.mapper.lines;
     options_.loop.global_ba_options.line_information = options_.mapper.line_information;
@@ -126,12 +127,20 @@ FrameResult System::process(const io::StereoFrame& frame) {
 void System::note_revisit(const tracking::TrackResult& track) {
   // A relocalization that follows tracked frames is a revisit (the first pose of a loaded map is
   // not); its first new keyframe is where the revisit joins the map.
-  if (track.relocalized && tracked_before_) revisit_pending_ = true;
-  if (track.tracked) tracked_before_ = true;
-  if (!revisit_pending_ || !track.keyframe || tracker_->records().empty()) return;
+  // The keyframe the trusted trajectory last stood on before the loss is where the path's drift
+  // ends: loop closing may tie it to the place (LoopClosingOptions::loop_across_relocalization).
+  if (track.relocalized && tracked_before_) {
+    revisit_pending_ = true;
+    revisit_from_ = trusted_reference_;
+  }
+  const map::KeyFrame* reference = tracker_->records().empty() ? nullptr : tracker_->records().back().reference;
+  if (track.tracked) {
+    tracked_before_ = true;
+    if (!track.relocalized && reference) trusted_reference_ = reference->id();
+  }
+  if (!revisit_pending_ || !track.keyframe || !reference) return;
   revisit_pending_ = false;
-  const map::KeyFrame* kf = tracker_->records().back().reference;
-  if (loop_closer_ && kf) loop_closer_->global_ba_after_keyframe(kf->id());
+  if (loop_closer_) loop_closer_->global_ba_after_keyframe(reference->id(), revisit_from_);
 }
 
 void System::reclaim_culled() {

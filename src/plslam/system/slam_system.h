@@ -116,9 +116,11 @@ class System {
   std::unique_ptr<tracking::Tracker> tracker_;
   StereoCalibration calib_;
   bool finished_ = false;
-  long reclaimed_at_keyframe_ = 0;
-  bool tracked_before_ = false;   // some frame of this run was tracked
-  bool revisit_pending_ = false;  // relocalized after a loss; its first keyframe asks for a global BA  // map_.next_ids().keyframe at the last reclamation
+  long reclaimed_at_keyframe_ = 0;  // map_.next_ids().keyframe at the last reclamation
+  bool tracked_before_ = false;     // some frame of this run was tracked
+  long trusted_reference_ = -1;  // reference keyframe of the last trusted frame (not a relocalized one)
+  long revisit_from_ = -1;       // ... when the pending revisit's relocalization came
+  bool revisit_pending_ = false;  // relocalized after a loss; its first keyframe asks for a global BA
   ReclaimStats reclaim_stats_;
 };
 
