@@ -33,6 +33,25 @@ class MapperPause {
   mapping::LocalMapper& m_;
 };
 
+// A place: the keyframe and its covisible keyframes.
+std::vector<map::KeyFrame*> place_of(map::KeyFrame* kf) {
+  auto v = kf->covisibles();
+  v.insert(v.begin(), kf);
+  return v;
+}
+
+map::IdSet<map::KeyFrame> covisible_set(const map::KeyFrame& kf) {
+  const auto v = kf.covisibles();
+  return {v.begin(), v.end()};
+}
+
+// Whether a covisible keyframe of `kf` lies in `neighbourhood`: the two places are already tied
+// (an earlier loop's fusion, or tracking that relocalized there).
+bool touches(const map::IdSet<map::KeyFrame>& neighbourhood, const map::KeyFrame& kf) {
+  const auto group = kf.covisibles();
+  return std::any_of(group.begin(), group.end(), [&](map::KeyFrame* g) { return neighbourhood.count(g) > 0; });
+}
+
 }  // namespace
 
 void LoopClosingOptions::validate() const {
@@ -230,11 +249,7 @@ std::optional<LoopConstraint> LoopCloser::confirm(map::KeyFrame* kf, const LoopD
   pm.point_chi2 = options_.projection_radius * options_.projection_radius;
   const Eigen::Vector3d O = T_qw.inverse().translation();
   map::IdSet<map::MapPoint> place_points;
-  for (map::KeyFrame* k : [&] {
-         auto v = d.keyframe->covisibles();
-         v.insert(v.begin(), d.keyframe);
-         return v;
-       }()) {
+  for (map::KeyFrame* k : place_of(d.keyframe)) {
     for (map::MapPoint* p : k->map_points()) {
       if (p && !p->is_bad()) place_points.insert(p);
     }
@@ -339,14 +354,9 @@ bool LoopCloser::close_loop(map::KeyFrame* kf) {
   // A place the keyframe's neighbourhood already shares keyframes with is already tied to it (an
   // earlier loop's fusion, or tracking that relocalized there): correcting it again would only
   // move the map by the noise of a second estimate.
-  map::IdSet<map::KeyFrame> neighbourhood;
-  for (map::KeyFrame* n : kf->covisibles()) neighbourhood.insert(n);
+  const auto neighbourhood = covisible_set(*kf);
   for (const auto& d : detections) {
-    if (d.keyframe->is_bad()) continue;
-    const auto group = d.keyframe->covisibles();
-    if (std::any_of(group.begin(), group.end(), [&](map::KeyFrame* g) { return neighbourhood.count(g) > 0; })) {
-      continue;
-    }
+    if (d.keyframe->is_bad() || touches(neighbourhood, *d.keyframe)) continue;
     loop = confirm(kf, d, options_.verifier);
     if (loop) break;
     ++rejected;
@@ -369,35 +379,27 @@ bool LoopCloser::close_loop_across_relocalization(map::KeyFrame* kf, long before
   for (map::KeyFrame* k : map_.keyframes()) {
     if (k->id() == before_id) before = k;
   }
-  if (!before || before->is_bad() || kf->is_bad()) return false;
+  if (!before) return false;
   MapperPause pause(mapper_);
   if (before->is_bad() || kf->is_bad()) return false;
   // A relocalization that continued the trusted trajectory left the two in one neighbourhood.
-  map::IdSet<map::KeyFrame> neighbourhood;
+  auto neighbourhood = covisible_set(*before);
   neighbourhood.insert(before);
-  for (map::KeyFrame* n : before->covisibles()) neighbourhood.insert(n);
-  const auto group = kf->covisibles();
-  if (neighbourhood.count(kf) ||
-      std::any_of(group.begin(), group.end(), [&](map::KeyFrame* g) { return neighbourhood.count(g) > 0; })) {
-    return false;
-  }
+  if (neighbourhood.count(kf) || touches(neighbourhood, *kf)) return false;
   // The drift to correct is that of the path since the place was seen: from the oldest keyframe
   // of the revisit's neighbourhood (where relocalization put the camera) to the one before the loss.
+  const auto revisit = place_of(kf);
   long place = kf->id();
-  for (map::KeyFrame* g : group) place = std::min(place, g->id());
+  for (map::KeyFrame* g : revisit) place = std::min(place, g->id());
   // The candidates: the revisit's keyframe and its neighbourhood, the most similar to the keyframe
   // before the loss first (the camera moved on during the loss, so another view of the place may
   // overlap it more).
   const auto description = database_.description(before);
   if (!description) return false;
   std::vector<std::pair<double, map::KeyFrame*>> candidates;
-  for (map::KeyFrame* c : [&] {
-         auto v = group;
-         v.insert(v.begin(), kf);
-         return v;
-       }()) {
+  for (map::KeyFrame* c : revisit) {
     const auto d = database_.description(c);
-    if (!d || c->is_bad() || neighbourhood.count(c)) continue;
+    if (!d || c->is_bad()) continue;
     candidates.emplace_back(place::l1_score(description->bow, d->bow), c);
   }
   std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.first > b.first; });

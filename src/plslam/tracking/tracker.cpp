@@ -161,7 +161,7 @@ Tracker::RecoveryCheck Tracker::check_recovery(const Frame& f, bool jumped) cons
   if (!e.enough) return RecoveryCheck::kRefuted;
   if (o.min_cell_coverage <= 0 || coverage.share() >= o.min_cell_coverage) return RecoveryCheck::kHolds;
   // A look-alike fails most of its frames; a true place may dip once after holding twice.
-  const bool forgiven = recovery_->cell_misses < o.max_cell_misses && recovery_->passed >= 2;
+  const bool forgiven = recovery_->cell_misses < o.max_cell_misses && recovery_->held() >= 2;
   return forgiven ? RecoveryCheck::kCellMiss : RecoveryCheck::kRefuted;
 }
 
@@ -252,7 +252,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       spdlog::info("frame {}: recovering from frame {} with inliers in too few image cells (miss {} of {} forgiven)",
                    f.id(), recovery_->since_frame, recovery_->cell_misses, options_.relocalization.max_cell_misses);
     }
-    if (tracked && check == RecoveryCheck::kRefuted) {
+    if (check == RecoveryCheck::kRefuted) {
       spdlog::warn("frame {}: the {} of frame {} is refuted after {} frames", f.id(),
                    recovery_->after_gap ? "tracking after the gap" : "relocalization", recovery_->since_frame,
                    recovery_->frames);
@@ -269,7 +269,6 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
       velocity_dt_ = f.data->timestamp - last_->data->timestamp;
       if (recovery_ && check == RecoveryCheck::kHolds) {
         ++recovery_->frames;
-        ++recovery_->passed;
         if (recovery_confirmed(f)) confirm_relocalization(f, result);
       }
       finish_tracked_frame(f, result);

@@ -340,8 +340,9 @@ class Tracker {
     geometry::SE3 T_cw;  // the relocalized pose
     bool after_gap = false;  // started by tracking across a gap, not by a relocalization
     bool trusted_before = false;  // trusted_since_recovery_ when it started
-    int passed = 0;       // recovering frames checked that held
-    int cell_misses = 0;  // ... and those forgiven a miss (RelocalizationOptions::max_cell_misses)
+    int cell_misses = 0;  // recovering frames forgiven a miss (RelocalizationOptions::max_cell_misses)
+    // Recovering frames checked that held: `frames` counts the relocalizing frame too.
+    int held() const { return after_gap ? frames : frames - 1; }
   };
   // Whether the recovery has seen enough (RelocalizationOptions::confirm_*) with `f` tracked.
   bool recovery_confirmed(const Frame& f) const;
