@@ -43,7 +43,7 @@ done
 # other two stages. The sequential end-to-end accuracy runs
 # are left to the other stages: in them local mapping runs in the tracking thread, and
 # RunConcurrent covers every seam between the threads.
-TSAN_SUITES='WorkerPool|LocalMapperThread|MapSnapshotConcurrent|BundleAdjustment|StereoPoints|FrameStream|LiveCapture|VideoDataset|SynthFormats|SynthDeterminism|RunConcurrent|TimeRobustness|SignalRobustness|KeyframeDatabase|RelocalizationConcurrent|LoopClosingConcurrent|ViewerServer|LiveViewerRun'
+TSAN_SUITES='WorkerPool|LocalMapperThread|MapSnapshotConcurrent|BundleAdjustment|StereoPoints|FrameStream|LiveCapture|VideoDataset|SynthFormats|SynthDeterminism|RunConcurrent|RunDeterministic|TimeRobustness|SignalRobustness|KeyframeDatabase|RelocalizationConcurrent|LoopClosingConcurrent|ViewerServer|LiveViewerRun'
 TSAN_TESTS="^(${TSAN_SUITES})\\."
 # The test executables that hold them (tests/<folder> -> test_<folder>), plus the CLI they run: the
 # TSan stage builds only these. A TSan suite in another folder stops the script (checked below),

@@ -41,6 +41,9 @@ plslam_test(RunConcurrent.SyntheticOfficeWithLocalMappingThread COST 28 LABELS t
 # Each runs plslam twice to compare the bytes: the same code as RunEndToEnd; with loop closing,
 # whose loop runs under the sanitizers in LoopClosingConcurrent.
 plslam_test(LoopRun.SequentialRunsWithALoopAreIdentical COST 27 LABELS sanitizer_skip)
+# Two --deterministic runs of the same loop (the deferred global BA's merge); the pipeline's threads
+# run under the sanitizers in RunDeterministic.
+plslam_test(LoopRun.DeterministicRunsWithALoopAreIdentical COST 27 LABELS sanitizer_skip)
 plslam_test(RunDeterminism.SequentialKittiRunsAreByteIdentical COST 6 LABELS sanitizer_skip)
 plslam_test(RunDeterminism.SequentialRenderedRunsAreByteIdentical COST 10 LABELS sanitizer_skip)
 plslam_test(RunConcurrent.EurocMicroWithLocalMappingThread COST 25)

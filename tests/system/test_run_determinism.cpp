@@ -37,7 +37,27 @@ nlohmann::json stats_without_timings(const fs::path& p) {
   }
   EXPECT_TRUE(j["reclaimed"].contains("ms"));  // reclamation's timings; what it freed must match
   j["reclaimed"].erase("ms");
+  EXPECT_TRUE(j.contains("tracking_waits"));  // where the deterministic pipeline's tracking waited
+  j.erase("tracking_waits");
   return j;
+}
+
+const char* const kOutputs[] = {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map_points.ply", "map_lines.ply"};
+
+// Runs `plslam run seq <mode> extra` into tmp/name; the stats.json without timings.
+nlohmann::json run_mode(const fs::path& seq, const fs::path& out, const std::string& mode, const std::string& extra) {
+  const auto r = test::run_cli("run \"" + seq.string() + "\" " + mode + " --quiet --out \"" + out.string() + "\"" + extra);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return r.exit_code == 0 ? stats_without_timings(out / "stats.json") : nlohmann::json{};
+}
+
+void expect_same_outputs(const fs::path& a, const fs::path& b, const std::string& what) {
+  for (const char* f : kOutputs) {
+    if (!fs::exists(a / f)) continue;
+    const std::string bytes = bytes_of(a / f);
+    EXPECT_FALSE(bytes.empty()) << f;
+    EXPECT_TRUE(bytes == bytes_of(b / f)) << f << " differs between " << what;
+  }
 }
 
 void expect_identical_sequential_runs(const fs::path& seq, const std::string& extra) {
@@ -48,12 +68,7 @@ void expect_identical_sequential_runs(const fs::path& seq, const std::string& ex
     const auto r = test::run_cli("run \"" + seq.string() + "\" --sequential --quiet --out \"" + outs.back().string() + "\"" + extra);
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
-  for (const char* f : {"trajectory.tum", "trajectory.kitti", "keyframes.tum", "map_points.ply", "map_lines.ply"}) {
-    if (!fs::exists(outs[0] / f)) continue;
-    const std::string a = bytes_of(outs[0] / f);
-    EXPECT_FALSE(a.empty()) << f;
-    EXPECT_TRUE(a == bytes_of(outs[1] / f)) << f << " differs between two --sequential runs";
-  }
+  expect_same_outputs(outs[0], outs[1], "two --sequential runs");
   EXPECT_TRUE(fs::exists(outs[0] / "map_points.ply"));
   const auto sa = stats_without_timings(outs[0] / "stats.json");
   EXPECT_EQ(sa, stats_without_timings(outs[1] / "stats.json"));
@@ -84,6 +99,29 @@ TEST(RunDeterminism, SequentialRenderedRunsAreByteIdentical) {
   const auto synth = test::run_cli("synth --out \"" + seq.string() + "\" --scene office --frames 80 --seed 3");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   expect_identical_sequential_runs(seq, "");
+}
+
+// --deterministic: local mapping and loop closing on their own thread beside the next frame's
+// extraction, met before tracking reads the map. Two runs are identical, and without a global BA
+// (none here: no loop) identical to --sequential's too. The ThreadSanitizer stage runs it.
+TEST(RunDeterministic, KittiRunsAreIdenticalToEachOtherAndToSequential) {
+  PLSLAM_REQUIRE_SHARED_DATA(data);
+  test::TempDir tmp;
+  const auto seq = data / "kitti/sequences/06";
+  const std::string extra = " --max-frames 30";
+  const auto a = run_mode(seq, tmp.path() / "a", "--deterministic", extra);
+  const auto b = run_mode(seq, tmp.path() / "b", "--deterministic", extra);
+  const auto s = run_mode(seq, tmp.path() / "s", "--sequential", extra);
+  ASSERT_FALSE(a.is_null());
+  EXPECT_EQ(a["mode"], "deterministic");
+  EXPECT_EQ(a, b);
+  expect_same_outputs(tmp.path() / "a", tmp.path() / "b", "two --deterministic runs");
+  expect_same_outputs(tmp.path() / "a", tmp.path() / "s", "--deterministic and --sequential");
+  EXPECT_GT(a["keyframes"].get<int>(), 3);
+  EXPECT_EQ(a["local_mapping"]["keyframes_processed"], s["local_mapping"]["keyframes_processed"]);
+  const auto r = test::run_cli("run \"" + seq.string() + "\" --deterministic --sequential --out \"" +
+                               (tmp.path() / "bad").string() + "\"");
+  EXPECT_EQ(r.exit_code, 2) << "the two modes exclude each other";
 }
 
 // --repeat N: N runs in run-1..N and their ATE spread in repeat.json; sequential runs have none.

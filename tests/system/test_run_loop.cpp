@@ -92,6 +92,35 @@ TEST_F(LoopRun, SequentialRunsWithALoopAreIdentical) {
   }
 }
 
+// --deterministic with the loop: the global BA optimises in its own thread and is merged before the
+// first frame 1 s (input time) after the loop's, the same frame in both runs, so the runs are
+// identical, loop closing and global BA included.
+TEST_F(LoopRun, DeterministicRunsWithALoopAreIdentical) {
+  test::TempDir out;
+  const auto config = out.path() / "merge.yaml";
+  std::ofstream(config) << "loop:\n  global_ba_merge_after_s: 1.0\n";
+  const std::string extra = " --deterministic --config \"" + config.string() + "\"";
+  auto a = run(out.path() / "a", extra);
+  auto b = run(out.path() / "b", extra);
+  expect_true_loops(a);
+  EXPECT_EQ(a["mode"], "deterministic");
+  // Merged during the run, at a frame 1 s after the loop's (6.7 frames at 6.7 Hz).
+  ASSERT_EQ(a["global_ba_merged_before_frames"].size(), 1u) << a.dump();
+  const long merged_at = a["global_ba_merged_before_frames"][0].get<long>();
+  const long loop_at = a["loops"][0]["frame"].get<long>();
+  EXPECT_GE(merged_at, loop_at + 7);
+  EXPECT_LE(merged_at, loop_at + 8);
+  EXPECT_LT(a["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.0095);  // the sequential run's bound
+  for (auto* s : {&a, &b}) {
+    for (auto& l : (*s)["loops"]) l.erase("correction_ms");  // timings differ
+  }
+  EXPECT_EQ(a["loops"], b["loops"]);
+  EXPECT_EQ(a["global_ba_merged_before_frames"], b["global_ba_merged_before_frames"]);
+  for (const char* f : {"trajectory.tum", "keyframes.tum", "map_points.ply", "map_lines.ply"}) {
+    EXPECT_EQ(test::read_file(out.path() / "a" / f), test::read_file(out.path() / "b" / f)) << f;
+  }
+}
+
 // The switch only: a short render of its own (the loop render costs minutes under the sanitizers).
 TEST(LoopClosingSwitch, NoLoopClosingLeavesTheThreadOut) {
   test::TempDir tmp;

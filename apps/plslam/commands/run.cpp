@@ -63,6 +63,7 @@ struct RunArgs {
   bool quiet = false;
   bool realtime = false;
   bool sequential = false;
+  bool deterministic = false;
   int repeat = 1;
   std::string save_map;  // --save-map FILE
   std::string load_map;  // --load-map FILE
@@ -127,6 +128,7 @@ std::string map_config_text(const RunArgs& args, io::DatasetFormat preset) {
                       {"no_lines", args.no_lines},
                       {"no_loop_closing", args.no_loop_closing},
                       {"sequential", args.sequential},
+                      {"deterministic", args.deterministic},
                       {"loaded_map", args.load_map}};
   if (!args.config.empty()) {
     std::ifstream in(args.config);
@@ -165,6 +167,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
       preset, args.config.empty() ? std::nullopt : std::optional<fs::path>(args.config));
   if (args.no_lines) options.disable_lines();
   options.sequential = args.sequential;
+  options.deterministic = args.deterministic;
   if (!args.vocabulary.empty()) options.vocabulary = args.vocabulary;
   if (args.no_place_recognition) options.place_recognition = false;
   if (args.no_loop_closing) options.loop_closing = false;
@@ -563,6 +566,10 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                                ->excludes(camera);
                            sub.add_flag("--sequential", args->sequential,
                                         "Run local mapping and loop closing in the tracking thread (reproducible runs)");
+                           sub.add_flag("--deterministic", args->deterministic,
+                                        "Threads meet at frames fixed in advance: runs are identical to each other "
+                                        "(local mapping as in --sequential, beside the next frame's extraction)")
+                               ->excludes("--sequential");
                            sub.add_option("--save-map", args->save_map,
                                           "Save the map at the end (after loop closing) to FILE (.plmap)");
                            auto* load = sub.add_option("--load-map", args->load_map,

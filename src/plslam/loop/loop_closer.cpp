@@ -69,6 +69,7 @@ void LoopClosingOptions::validate() const {
   if (keyframes_between_loops < 0) throw std::invalid_argument("loop.keyframes_between_loops: must be >= 0");
   global_ba_options.validate();
   if (!(finish_wait_s >= 0)) throw std::invalid_argument("loop.finish_wait_s: must be >= 0");
+  if (!(global_ba_merge_after_s >= 0)) throw std::invalid_argument("loop.global_ba_merge_after_s: must be >= 0");
 }
 
 LoopCloser::LoopCloser(map::Map& map, const place::KeyframeDatabase& database, mapping::LocalMapper& mapper,
@@ -152,9 +153,11 @@ void LoopCloser::wait_idle() {
 bool LoopCloser::finish() {
   wait_idle();
   std::unique_lock lock(gba_mutex_);
+  const bool deferred = options_.defer_global_ba_merge;
   const bool done = gba_cv_.wait_for(lock, std::chrono::duration<double>(options_.finish_wait_s),
-                                     [this] { return !gba_running_; });
+                                     [&] { return !gba_running_ || (deferred && gba_computed_); });
   lock.unlock();
+  if (deferred && done) merge_deferred_global_ba();
   if (!done) {
     spdlog::warn("global BA still running after {:.0f} s: aborted; the outputs use the map as the loop correction left it",
                  options_.finish_wait_s);
@@ -168,6 +171,63 @@ void LoopCloser::abort_global_ba() {
   gba_abort_ = true;
   gba_thread_.join();
   gba_abort_ = false;
+  if (!deferred_) return;
+  deferred_.reset();
+  spdlog::info("global BA dropped before its merge");
+  {
+    std::lock_guard lock(gba_mutex_);
+    gba_running_ = false;
+  }
+  gba_cv_.notify_all();
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.global_ba_aborted;
+}
+
+void LoopCloser::start_deferred_global_ba() {
+  deferred_ = std::make_unique<Deferred>();
+  deferred_->t0 = std::chrono::steady_clock::now();
+  deferred_->snapshot = snapshot_for_global_ba(map_, options_.global_ba_options);
+  {
+    std::lock_guard lock(gba_mutex_);
+    gba_running_ = true;
+    gba_computed_ = false;
+  }
+  ++gba_starts_;
+  gba_thread_ = std::thread([this, d = deferred_.get()] {
+    core::lower_this_thread_priority(kBackgroundNice);
+    core::name_this_thread("plslam-gba");
+    d->result = run_global_ba(d->snapshot, options_.global_ba_options, &gba_abort_);
+    {
+      std::lock_guard lock(gba_mutex_);
+      gba_computed_ = true;
+    }
+    gba_cv_.notify_all();
+  });
+}
+
+bool LoopCloser::merge_deferred_global_ba() {
+  if (!gba_thread_.joinable()) return false;
+  gba_thread_.join();
+  auto d = std::move(deferred_);
+  {
+    std::lock_guard lock(gba_mutex_);
+    gba_running_ = false;
+  }
+  gba_cv_.notify_all();
+  if (!d) return false;
+  if (d->result.aborted || !d->result.usable) {
+    spdlog::info("global BA {}", d->result.usable ? "aborted" : "unusable: " + d->result.message);
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.global_ba_aborted;
+    return false;
+  }
+  GlobalBaMergeStats merged;
+  {
+    std::lock_guard map_lock(map_.update_mutex());
+    merged = merge_global_ba(map_, d->snapshot, d->result);
+  }
+  record_global_ba(merged, d->result, ms_since(d->t0));
+  return true;
 }
 
 void LoopCloser::global_ba() {
@@ -191,7 +251,10 @@ void LoopCloser::global_ba() {
     std::lock_guard map_lock(map_.update_mutex());
     merged = merge_global_ba(map_, snapshot, result);
   }
-  const double ms = ms_since(t0);
+  record_global_ba(merged, result, ms_since(t0));
+}
+
+void LoopCloser::record_global_ba(const GlobalBaMergeStats& merged, const optim::BaResult& result, double ms) {
   spdlog::info("global BA: {} keyframes, {} points, {} lines, {} iterations, cost {:.4g} -> {:.4g}; merged with {} new "
                "keyframes; {:.0f} ms",
                merged.keyframes, merged.points, merged.lines, result.iterations, result.initial_cost, result.final_cost,
@@ -462,6 +525,10 @@ void LoopCloser::correct(const LoopConstraint& loop, map::KeyFrame* newest) {
 }
 
 void LoopCloser::start_global_ba() {
+  if (options_.defer_global_ba_merge) {
+    start_deferred_global_ba();
+    return;
+  }
   if (!thread_.joinable()) {  // sequential: in the caller, for reproducible runs
     global_ba();
     return;

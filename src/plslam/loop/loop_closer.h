@@ -5,6 +5,8 @@
 // refining the pose over their reprojection errors, and corrects the map (loop_correction.h)
 // while local mapping is paused and tracking waits on the map's update lock.
 #include <atomic>
+#include <chrono>
+#include <memory>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -63,6 +65,15 @@ struct LoopClosingOptions {
   GlobalBaOptions global_ba_options;
   // At the end of a run, how long finish() waits for a running global BA before aborting it.
   double finish_wait_s = 120;
+  // The deterministic pipeline: the global BA's snapshot is taken where it starts (in the caller,
+  // at a point fixed by the frames), it optimises in its own thread, and its result enters the map
+  // only when the caller says, with merge_deferred_global_ba() at a frame fixed in advance. A
+  // later loop or revisit drops a result not merged yet, as it aborts a running one.
+  bool defer_global_ba_merge = false;
+  // ... and that frame: the first whose timestamp is this many seconds after the frame whose
+  // keyframe started it (tracking waits there if the optimisation is not done). Long enough for
+  // the optimisation to finish beside tracking and mapping on 2 cores, so no frame waits.
+  double global_ba_merge_after_s = 3.0;
   // Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
@@ -114,6 +125,12 @@ class LoopCloser {
   // wait_idle(), then waits up to options.finish_wait_s for a running global BA (aborting it after
   // that, with a warning); returns false if it had to abort.
   bool finish();
+  // defer_global_ba_merge: how many global BAs have started (the caller notes a new one to fix
+  // the frame of its merge), and the merge itself: waits for the optimisation, then writes it into
+  // the map (local mapping must be at rest). True if a result was merged; false if none was pending,
+  // or it was dropped or unusable. Call from the thread that calls process_pending().
+  long global_ba_starts() const { return gba_starts_; }
+  bool merge_deferred_global_ba();
   // Holds loop closing only if idle: nothing queued or in progress, no global BA running; true if
   // it did (resume() after). For Map::reclaim(), which needs every thread at rest.
   bool try_pause();
@@ -141,7 +158,12 @@ class LoopCloser {
   bool plausible(map::KeyFrame* query, map::KeyFrame* candidate, const geometry::SE3& T_qw_corrected, long path_from);
   // Snapshot, optimise, merge (unless aborted).
   void global_ba();
+  // defer_global_ba_merge: the snapshot here, the optimisation in gba_thread_.
+  void start_deferred_global_ba();
+  // Joins the global BA thread, cutting it short; a deferred result not merged yet is dropped.
   void abort_global_ba();
+  // The statistics of a merged global BA.
+  void record_global_ba(const GlobalBaMergeStats& merged, const optim::BaResult& result, double ms);
 
   map::Map& map_;
   const place::KeyframeDatabase& database_;
@@ -164,7 +186,15 @@ class LoopCloser {
   std::atomic<bool> gba_abort_{false};
   std::mutex gba_mutex_;
   std::condition_variable gba_cv_;
-  bool gba_running_ = false;
+  bool gba_running_ = false;  // running, or (deferred) computed and not merged yet
+  bool gba_computed_ = false;  // deferred: the optimisation has finished
+  long gba_starts_ = 0;
+  struct Deferred {
+    GlobalBaSnapshot snapshot;
+    optim::BaResult result;
+    std::chrono::steady_clock::time_point t0;
+  };
+  std::unique_ptr<Deferred> deferred_;  // written by gba_thread_ until it is joined
 
   mutable std::mutex stats_mutex_;
   LoopClosingStats stats_;

@@ -348,6 +348,9 @@ std::vector<ConfigKey> make_table() {
           "global BA drops the observations beyond their gate after its robust pass and runs a second pass"),
     field("loop", "finish_wait_s", [](auto& o) -> auto& { return o.loop.finish_wait_s; },
           "at the end of a run, seconds to wait for a running global BA"),
+    field("loop", "global_ba_merge_after_s", [](auto& o) -> auto& { return o.loop.global_ba_merge_after_s; },
+          "deterministic mode: a global BA's result enters the map at the first frame this many seconds "
+          "(input time) after the frame that started it; tracking waits there if it is not done"),
 
     unsigned_field("system", "seed", [](auto& o) -> auto& { return o.seed; },
                    "seed of every random choice (the PnP RANSAC of relocalization and loop closing)", at_least(0)),

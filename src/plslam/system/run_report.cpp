@@ -124,6 +124,12 @@ nlohmann::json RunReport::to_json(const System& slam) const {
       {"keyframes_per_busy_s", busy_ms > 0 ? nlohmann::json(1000.0 * ms.keyframe_ms.size() / busy_ms) : nullptr},
       {"max_queue", ms.max_queue},
       {"keyframes_refused_queue_full", slam.tracker().keyframes_refused_queue_full()}};
+  // Deterministic mode: where tracking waited for the other threads (timings, like the ms above).
+  auto waits = [](const WaitStats& w) {
+    return nlohmann::json{{"count", w.count}, {"total_ms", w.total_ms}, {"max_ms", w.max_ms}};
+  };
+  const nlohmann::json tracking_waits = {{"mapping", waits(slam.mapping_waits())},
+                                         {"global_ba_merge", waits(slam.global_ba_waits())}};
   const auto init = slam.initialized_at();
   std::vector<long> lost_ids;
   std::size_t before_init = 0;
@@ -144,7 +150,9 @@ nlohmann::json RunReport::to_json(const System& slam) const {
     skipped_json.push_back({{"frame", s.index}, {"timestamp", s.timestamp}, {"reason", s.reason}});
   }
   return {{"complete", complete},
-          {"mode", slam.options().sequential ? "sequential" : "concurrent"},
+          {"mode", slam.options().sequential       ? "sequential"
+                   : slam.options().deterministic ? "deterministic"
+                                                  : "concurrent"},
           {"seed", slam.options().seed},
           {"input_frames", input_frames},
           {"frames", frames},
@@ -172,6 +180,7 @@ nlohmann::json RunReport::to_json(const System& slam) const {
           {"global_ba_ms", global_ba_ms(slam)},
           {"global_ba_runs", slam.loop_closer() ? slam.loop_closer()->stats().global_ba_runs : 0},
           {"global_ba_aborted", slam.loop_closer() ? slam.loop_closer()->stats().global_ba_aborted : 0},
+          {"global_ba_merged_before_frames", slam.global_ba_merge_frames()},
           {"skipped_frames", skipped.size()},
           {"skipped", skipped_json},
           {"untracked_kitti_lines", untracked_lines},
@@ -201,6 +210,7 @@ nlohmann::json RunReport::to_json(const System& slam) const {
             {"triangulation", percentile(ms.triangulation_ms, 0.5)},
             {"fusion", percentile(ms.fusion_ms, 0.5)}}},
           {"local_mapping", local_mapping},
+          {"tracking_waits", tracking_waits},
           {"aborted_local_ba", ms.aborted_local_ba},
           {"mapping_pause_wait_ms", pause_wait},
           {"culled_keyframes", ms.culled_keyframes},

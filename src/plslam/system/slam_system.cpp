@@ -2,6 +2,7 @@
 
 #include "plslam/core/resident_memory.h"
 #include "plslam/core/stopwatch.h"
+#include "plslam/core/thread_priority.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -85,11 +86,14 @@ System::System(const StereoCalibration& calib, SystemOptions options, std::share
     options_.loop.global_ba_options.lines = options_.mapper.lines;
     options_.loop.global_ba_options.line_information = options_.mapper.line_information;
     options_.loop.global_ba_options.far_stereo_baselines = options_.mapper.far_stereo_baselines;
+    options_.loop.defer_global_ba_merge = deterministic();
     loop_closer_ = std::make_unique<loop::LoopCloser>(map_, *database_, *mapper_, options_.loop);
     mapper_->set_keyframe_sink([closer = loop_closer_.get()](map::KeyFrame* kf) { closer->insert(kf); });
   }
   auto* mapper = mapper_.get();
-  const bool sequential = options_.sequential;
+  // Deterministic mode: tracking reads the map only once mapping has processed every keyframe
+  // queued before, as in sequential mode.
+  const bool sequential = options_.sequential || deterministic();
   tracker_ = std::make_unique<tracking::Tracker>(
       map_, options_.tracker, [mapper](map::KeyFrame* kf) { mapper->insert(kf); },
       [mapper, sequential] { return sequential || mapper->idle(); });
@@ -111,14 +115,25 @@ FrameResult System::process(const io::StereoFrame& frame) {
   // The id is the frame's place in the input, so skipped frames leave gaps instead of shifting
   // every later frame (the keyframe policy counts frames by id, the outputs align by it).
   auto data = extractor_.extract(static_cast<long>(frame.index), frame.timestamp, frame.left, frame.right, &r.extraction);
+  if (deterministic()) {
+    // The meeting point: the map as the last frame's keyframes left it, whatever the timing.
+    join_mapping_job();
+    merge_due_global_ba(static_cast<long>(frame.index), frame.timestamp);
+    reclaim_culled();
+  }
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
   note_revisit(r.track);
-  if (options_.sequential) {
-    mapper_->process_pending();
-    if (loop_closer_) loop_closer_->process_pending();
+  if (deterministic()) {
+    start_mapping_job();
+  } else {
+    if (options_.sequential) {
+      mapper_->process_pending();
+      if (loop_closer_) loop_closer_->process_pending();
+    }
+    reclaim_culled();
   }
-  reclaim_culled();
+  last_timestamp_ = frame.timestamp;
   r.map_size = map_.sizes();
   r.rss_mb = core::resident_memory_mb();
   return r;
@@ -161,9 +176,49 @@ void System::reclaim_culled() {
   mapper_->resume();
 }
 
+void WaitStats::add(double ms) {
+  if (ms <= 0.1) return;
+  ++count;
+  total_ms += ms;
+  max_ms = std::max(max_ms, ms);
+}
+
+bool System::deterministic() const { return options_.deterministic && !options_.sequential; }
+
+void System::start_mapping_job() {
+  if (mapper_->queued() == 0) return;
+  mapping_job_ = std::thread([this] {
+    core::name_this_thread("plslam-mapping");
+    mapper_->process_pending();
+    if (loop_closer_) loop_closer_->process_pending();
+  });
+}
+
+void System::join_mapping_job() {
+  if (!mapping_job_.joinable()) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  mapping_job_.join();
+  mapping_waits_.add(ms_since(t0));
+}
+
+void System::merge_due_global_ba(long frame_id, double timestamp) {
+  if (!loop_closer_) return;
+  if (const long starts = loop_closer_->global_ba_starts(); starts != seen_global_ba_starts_) {
+    // Started by the last frame's keyframe: its merge frame is fixed now, by input time.
+    seen_global_ba_starts_ = starts;
+    global_ba_merge_at_ = last_timestamp_ + options_.loop.global_ba_merge_after_s;
+  }
+  if (global_ba_merge_at_ < 0 || timestamp < global_ba_merge_at_) return;
+  global_ba_merge_at_ = -1;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (loop_closer_->merge_deferred_global_ba()) global_ba_merge_frames_.push_back(frame_id);
+  global_ba_waits_.add(ms_since(t0));
+}
+
 void System::finish() {
   if (finished_) return;
   finished_ = true;
+  join_mapping_job();
   mapper_->wait_idle();
   mapper_->stop();
   if (loop_closer_) {

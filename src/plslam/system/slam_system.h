@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <thread>
+#include <vector>
 
 #include "plslam/core/types.h"
 #include "plslam/io/dataset.h"
@@ -24,6 +26,12 @@ struct SystemOptions {
   tracking::TrackerOptions tracker;
   mapping::LocalMapperOptions mapper;
   bool sequential = false;
+  // The deterministic pipeline (ignored with `sequential`): local mapping and loop closing work on
+  // their own thread while the next frame's features are extracted, and tracking waits for them
+  // before it reads the map; the global BA optimises beside both and is merged at a frame fixed in
+  // advance (loop.global_ba_merge_after_s). Runs are identical to --sequential's up to the first
+  // global BA, and identical to each other; see the README ("How the threads meet").
+  bool deterministic = false;
   // Seed of every random choice (config `system.seed`, recorded in stats.json): the PnP RANSAC
   // of relocalization (geometry::PnpOptions::seed). Tracking, mapping and BA make none.
   std::uint32_t seed = 1;
@@ -42,6 +50,15 @@ struct SystemOptions {
   static SystemOptions kitti();
   // Switches lines off everywhere (--no-lines).
   void disable_lines();
+};
+
+// How long tracking waited for the other threads at the points where they meet (deterministic
+// mode): a frame whose wait exceeded 0.1 ms counts.
+struct WaitStats {
+  int count = 0;
+  double total_ms = 0;
+  double max_ms = 0;
+  void add(double ms);
 };
 
 struct FrameResult {
@@ -98,6 +115,12 @@ class System {
     std::vector<double> ms;
   };
   const ReclaimStats& reclaim_stats() const { return reclaim_stats_; }
+  // Deterministic mode: the waits for local mapping and loop closing, and for a global BA's merge.
+  const WaitStats& mapping_waits() const { return mapping_waits_; }
+  const WaitStats& global_ba_waits() const { return global_ba_waits_; }
+  // Deterministic mode: the frames before which a global BA was merged (one merged at the end of
+  // the run is not listed).
+  const std::vector<long>& global_ba_merge_frames() const { return global_ba_merge_frames_; }
 
  private:
   // Frees the culled points and lines when every thread is at rest: tracking between frames,
@@ -106,6 +129,13 @@ class System {
   void reclaim_culled();
   // After a relocalization in the same map, asks loop closing for a global BA at the next keyframe.
   void note_revisit(const tracking::TrackResult& track);
+  // Deterministic mode: local mapping and loop closing of what the last frame queued, in
+  // mapping_job_; and the meeting point before the next frame reads the map.
+  void start_mapping_job();
+  void join_mapping_job();
+  // Deterministic mode: fixes the merge frame of a global BA that started, and merges it there.
+  void merge_due_global_ba(long frame_id, double timestamp);
+  bool deterministic() const;
 
   SystemOptions options_;
   map::Map map_;
@@ -122,6 +152,13 @@ class System {
   long revisit_from_ = -1;       // ... when the pending revisit's relocalization came
   bool revisit_pending_ = false;  // relocalized after a loss; its first keyframe asks for a global BA
   ReclaimStats reclaim_stats_;
+  std::thread mapping_job_;
+  long seen_global_ba_starts_ = 0;
+  double last_timestamp_ = 0;       // the last frame's input time
+  double global_ba_merge_at_ = -1;  // input time of the pending global BA's merge (-1: none)
+  WaitStats mapping_waits_;
+  WaitStats global_ba_waits_;
+  std::vector<long> global_ba_merge_frames_;
 };
 
 }  // namespace plslam::system
