@@ -47,7 +47,10 @@ void add_bench_slam_options(CLI::App& sub, BenchSlamArgs& a) {
   sub.add_option("--shared", a.shared, "The shared folder for --preset paper (default: $PLSLAM_SHARED_DIR, else ../shared)");
   sub.add_option("--jobs", a.jobs, "Runs at a time (only 1: parallel runs would distort every timing)")
       ->check(CLI::Range(1, 1))->capture_default_str();
-  sub.add_flag("--sequential", a.sequential, "plslam runs with --sequential (reproducible; anchors unaffected)");
+  auto* sequential =
+      sub.add_flag("--sequential", a.sequential, "plslam runs with --sequential (reproducible; anchors unaffected)");
+  sub.add_flag("--deterministic", a.deterministic, "plslam runs with --deterministic (anchors unaffected)")
+      ->excludes(sequential);
   sub.add_option("--table1-frames", a.table1_frames, "Frames per dataset for Table I (keypoint distribution); 0: skip")
       ->check(CLI::Range(0, 100000))->capture_default_str();
   sub.add_flag("--json", a.json, "Print report.json on stdout (logs stay on stderr)");
@@ -130,6 +133,7 @@ std::vector<std::string> job_argv(const bench::BenchRow& row, const fs::path& da
   std::vector<std::string> argv = {current_executable().string(), "run", dataset.string(), "--out", folder.string(),
                                    "--quiet", "--config", (out / "configs" / (row.name + ".yaml")).string()};
   if (a.sequential) argv.push_back("--sequential");
+  if (a.deterministic) argv.push_back("--deterministic");
   return argv;
 }
 
@@ -145,6 +149,7 @@ std::string command_line(const BenchSlamArgs& a) {
   if (!a.anchor.empty()) c += " --anchor " + arg(a.anchor);
   if (!a.shared.empty()) c += " --shared " + arg(a.shared);
   if (a.sequential) c += " --sequential";
+  if (a.deterministic) c += " --deterministic";
   if (a.table1_frames != 20) c += fmt::format(" --table1-frames {}", a.table1_frames);
   return c + " --out " + arg(a.out);
 }
@@ -261,7 +266,7 @@ int run_bench_slam(const BenchSlamArgs& a) {
   report["date"] = now_utc();
   report["hardware_threads"] = std::thread::hardware_concurrency();
   report["runs"] = a.runs;
-  report["mode"] = a.sequential ? "sequential" : "concurrent";
+  report["mode"] = a.sequential ? "sequential" : a.deterministic ? "deterministic" : "concurrent";
   report["preset"] = a.preset.empty() ? json(nullptr) : json(a.preset);
   report["anchor"] = a.anchor.empty() ? json(nullptr) : json(a.anchor);
   report["configurations"] = json::array();

@@ -18,6 +18,7 @@ struct BenchSlamArgs {
   std::string shared;  // ../shared for --preset paper
   int jobs = 1;
   bool sequential = false;
+  bool deterministic = false;
   int table1_frames = 20;
   bool json = false;
 };

@@ -119,6 +119,9 @@ TEST(RunDeterministic, KittiRunsAreIdenticalToEachOtherAndToSequential) {
   expect_same_outputs(tmp.path() / "a", tmp.path() / "s", "--deterministic and --sequential");
   EXPECT_GT(a["keyframes"].get<int>(), 3);
   EXPECT_EQ(a["local_mapping"]["keyframes_processed"], s["local_mapping"]["keyframes_processed"]);
+  // Every keyframe gets its local BA (the first two have no window yet).
+  EXPECT_EQ(a["local_mapping"]["local_ba_skipped"], 0);
+  EXPECT_EQ(a["local_mapping"]["local_ba_runs"].get<int>(), a["local_mapping"]["keyframes_processed"].get<int>() - 2);
   const auto r = test::run_cli("run \"" + seq.string() + "\" --deterministic --sequential --out \"" +
                                (tmp.path() / "bad").string() + "\"");
   EXPECT_EQ(r.exit_code, 2) << "the two modes exclude each other";

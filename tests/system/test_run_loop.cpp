@@ -111,6 +111,7 @@ TEST_F(LoopRun, DeterministicRunsWithALoopAreIdentical) {
   EXPECT_GE(merged_at, loop_at + 7);
   EXPECT_LE(merged_at, loop_at + 8);
   EXPECT_LT(a["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.0095);  // the sequential run's bound
+  EXPECT_EQ(a["local_mapping"]["local_ba_skipped"], 0);
   for (auto* s : {&a, &b}) {
     for (auto& l : (*s)["loops"]) l.erase("correction_ms");  // timings differ
   }

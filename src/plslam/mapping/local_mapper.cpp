@@ -152,17 +152,21 @@ void LocalMapper::process(map::KeyFrame* kf, bool more_waiting) {
   triangulate(kf);
   const double triangulation_ms = ms_since(t);
   double fusion_ms = -1;
+  const bool ba_due = options_.local_ba && map_.num_keyframes() > 2;
+  bool ba_skipped = ba_due && more_waiting;
   // Like ORB-SLAM2: the expensive steps only when tracking is not waiting with more keyframes.
   if (!more_waiting) {
     t = Clock::now();
     fuse(kf);
     fusion_ms = ms_since(t);
     // An abort raised before the BA starts (a pause, a newer keyframe) skips it.
-    if (options_.local_ba && map_.num_keyframes() > 2 && !abort_ba_) local_bundle_adjustment(kf);
+    ba_skipped = ba_due && abort_ba_;
+    if (ba_due && !ba_skipped) local_bundle_adjustment(kf);
     cull_keyframes(kf);
   }
   {
     std::lock_guard lock(stats_mutex_);
+    stats_.skipped_local_ba += ba_skipped;
     stats_.keyframe_ms.push_back(ms_since(t0));
     stats_.triangulation_ms.push_back(triangulation_ms);
     if (fusion_ms >= 0) stats_.fusion_ms.push_back(fusion_ms);

@@ -54,6 +54,9 @@ struct LocalMapperStats {
   std::vector<double> fusion_ms;         // per keyframe that ran it
   int culled_keyframes = 0;
   int aborted_local_ba = 0;              // cut short by abort_ba(), pause() or a new keyframe
+  // Keyframes whose local BA never started: more keyframes were waiting (fusion was skipped too),
+  // or an abort (a pause for loop closing, a newer keyframe) came first.
+  int skipped_local_ba = 0;
   // The most keyframes ever waiting in the queue (the one being processed not counted), each
   // insert() included: 1 when mapping always kept up. A queue that grows means mapping cannot
   // keep up, and the keyframes waiting skip fusion and local BA (process()).

@@ -180,6 +180,9 @@ std::vector<ConfigKey> make_table() {
           "a keyframe when the tracked inliers fall below this share of the reference's (with the PID offset)"),
     field("keyframe", "max_frames", [](auto& o) -> auto& { return o.tracker.keyframe.max_frames; },
           "frames after which a keyframe is due regardless"),
+    field("keyframe", "min_frames", [](auto& o) -> auto& { return o.tracker.keyframe.min_frames; },
+          "frames since the last keyframe before the inlier rule may take one (tracking too weak or close "
+          "points missing still take one)"),
     field("keyframe", "pid", [](auto& o) -> auto& { return o.tracker.keyframe.pid; },
           "the PID offset on the inlier rule"),
     field("keyframe", "pid_kp", [](auto& o) -> auto& { return o.tracker.keyframe.pid_gains.kp; }, "PID gain kp"),

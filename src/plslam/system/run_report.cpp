@@ -123,6 +123,8 @@ nlohmann::json RunReport::to_json(const System& slam) const {
       {"keyframe_ms", summarize(ms.keyframe_ms)},
       {"keyframes_per_busy_s", busy_ms > 0 ? nlohmann::json(1000.0 * ms.keyframe_ms.size() / busy_ms) : nullptr},
       {"max_queue", ms.max_queue},
+      {"local_ba_runs", ms.local_ba_ms.size()},
+      {"local_ba_skipped", ms.skipped_local_ba},
       {"keyframes_refused_queue_full", slam.tracker().keyframes_refused_queue_full()}};
   // Deterministic mode: where tracking waited for the other threads (timings, like the ms above).
   auto waits = [](const WaitStats& w) {
