@@ -159,7 +159,8 @@ PYBIND11_MODULE(plslam, m) {
   py::class_<Slam>(m, "System")
       .def(py::init([](const py::object& calibration, std::optional<std::filesystem::path> config,
                        const std::string& preset, bool lines, bool place_recognition, bool loop_closing,
-                       bool sequential, bool localization_only, std::optional<std::filesystem::path> vocabulary) {
+                       bool sequential, bool deterministic, bool localization_only,
+                       std::optional<std::filesystem::path> vocabulary) {
              SlamOptions o;
              o.preset = parse_preset(preset);
              if (config) o.config_file = *config;
@@ -168,6 +169,7 @@ PYBIND11_MODULE(plslam, m) {
              o.place_recognition = place_recognition;
              o.loop_closing = loop_closing;
              o.sequential = sequential;
+             o.deterministic = deterministic;
              o.localization_only = localization_only;
              const auto calib = calibration_of(calibration);
              py::gil_scoped_release release;  // loads the vocabulary
@@ -175,7 +177,7 @@ PYBIND11_MODULE(plslam, m) {
            }),
            py::arg("calibration"), py::kw_only(), py::arg("config") = py::none(), py::arg("preset") = "euroc",
            py::arg("lines") = true, py::arg("place_recognition") = true, py::arg("loop_closing") = true,
-           py::arg("sequential") = false, py::arg("localization_only") = false, py::arg("vocabulary") = py::none(),
+           py::arg("sequential") = false, py::arg("deterministic") = false, py::arg("localization_only") = false, py::arg("vocabulary") = py::none(),
            "calibration: a StereoCalibration or the path of a calibration file")
       .def(
           "track",

@@ -51,6 +51,10 @@ struct SlamOptions {
   // Local mapping and loop closing run inside track() instead of their own threads: slower, and
   // the poses are the same from run to run.
   bool sequential = false;
+  // Local mapping and loop closing on their own thread, met before the next frame is tracked
+  // (README "How the threads meet"): the same poses from run to run, as sequential's up to the
+  // first global BA. Ignored with sequential.
+  bool deterministic = false;
   // With load_map(): track in the loaded map without adding keyframes, points or lines.
   bool localization_only = false;
 };

@@ -131,6 +131,21 @@ def test_tracking_releases_the_gil(office_short):
     assert sum(during) > 0, during
 
 
+def test_deterministic_tracking_ends_with_the_sequential_trajectory(office_short):
+    """deterministic=True: mapping beside the next frame's extraction; with no loop, the final
+    trajectory is sequential's."""
+    ds = plslam.Dataset(str(office_short))
+    trajectories = []
+    for kw in ({"deterministic": True}, {"sequential": True}):
+        slam = plslam.System(ds.calibration, **kw)
+        for t, left, right in (ds[i] for i in range(30)):
+            slam.track(left, right, t)
+        slam.shutdown()
+        trajectories.append(slam.trajectory())
+    assert trajectories[0].shape == (30, 8)
+    assert np.array_equal(trajectories[0], trajectories[1])
+
+
 def test_office_loop_poses_equal_the_cli_sequential_run(office_loop, tmp_path):
     """Python tracking of the office loop gives the CLI's poses (both --sequential)."""
     ds = plslam.Dataset(str(office_loop))

@@ -90,6 +90,43 @@ TEST(PublicApi, TracksASequenceWithPosesTheTrajectoryAndMapAgreeOn) {
   EXPECT_LT(errors.ate_rmse_m, 0.02);
 }
 
+// deterministic: mapping beside the next frame's extraction, met before the next frame is tracked.
+// track() returns each pose before its keyframe's local mapping (which still runs then), the same
+// in every run; the final trajectory is sequential's, bit for bit (no loop in 60 frames).
+TEST(PublicApi, DeterministicTrackingIsReproducibleAndEndsWithTheSequentialTrajectory) {
+  const Sequence seq(api_sequence());
+  struct Run {
+    std::vector<Eigen::Isometry3d> returned;
+    Trajectory final;
+  };
+  auto run = [&](bool deterministic) {
+    auto o = sequential_options(seq);
+    o.sequential = !deterministic;
+    o.deterministic = deterministic;
+    Slam slam(seq.calibration(), o);
+    Run r;
+    for (std::size_t i = 0; i < seq.size(); ++i) {
+      const auto images = seq.frame(i);
+      r.returned.push_back(slam.track(images.left, images.right, images.timestamp).T_world_camera);
+    }
+    slam.shutdown();
+    EXPECT_GT(slam.stats().keyframes, 3u);
+    r.final = slam.trajectory();
+    return r;
+  };
+  const auto a = run(true);
+  const auto b = run(true);
+  const auto s = run(false);
+  ASSERT_EQ(a.returned.size(), b.returned.size());
+  for (std::size_t i = 0; i < a.returned.size(); ++i) {
+    EXPECT_TRUE(a.returned[i].matrix() == b.returned[i].matrix()) << "frame " << i;
+  }
+  ASSERT_EQ(a.final.size(), s.final.size());
+  for (std::size_t i = 0; i < a.final.size(); ++i) {
+    EXPECT_TRUE(a.final[i].T.matrix() == s.final[i].T.matrix()) << "frame " << i;
+  }
+}
+
 TEST(PublicApi, RefusesBadImagesTimestampsAndCallsAfterShutdown) {
   const Sequence seq(api_sequence());
   Slam slam(seq.calibration(), sequential_options(seq));

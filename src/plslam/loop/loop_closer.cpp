@@ -187,6 +187,8 @@ void LoopCloser::start_deferred_global_ba() {
   deferred_ = std::make_unique<Deferred>();
   deferred_->t0 = std::chrono::steady_clock::now();
   deferred_->snapshot = snapshot_for_global_ba(map_, options_.global_ba_options);
+  spdlog::debug("global BA snapshot: {} keyframes, {:.1f} ms", deferred_->snapshot.problem->keyframes.size(),
+                ms_since(deferred_->t0));
   {
     std::lock_guard lock(gba_mutex_);
     gba_running_ = true;

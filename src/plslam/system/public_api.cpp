@@ -71,6 +71,7 @@ system::SystemOptions system_options(const SlamOptions& o) {
   if (!o.place_recognition) options.place_recognition = false;
   if (!o.loop_closing) options.loop_closing = false;
   options.sequential = o.sequential;
+  options.deterministic = o.deterministic;
   options.localization_only = o.localization_only;
   return options;
 }
@@ -188,10 +189,8 @@ TrackedFrame Slam::track(const cv::Mat& left, const cv::Mat& right, double times
   out.frame_state = static_cast<FrameState>(r.track.frame_state);
   out.tracked = r.track.tracked;
   if (r.track.tracked) {
-    // The frame's record: its pose relative to its reference keyframe, which is where the
-    // trajectory takes it from too.
-    const auto& record = d.slam->tracker().records().back();
-    out.T_world_camera = tracking::Tracker::pose_of(record).inverse().isometry();
+    // From the frame's reference keyframe, which is where the trajectory takes it from too.
+    out.T_world_camera = *r.T_world_camera;
     ++d.tracked;
   }
   out.point_inliers = r.track.point_inliers;

@@ -124,7 +124,11 @@ FrameResult System::process(const io::StereoFrame& frame) {
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
   note_revisit(r.track);
+  auto pose_now = [&] {
+    if (r.track.tracked) r.T_world_camera = tracking::Tracker::pose_of(tracker_->records().back()).inverse().isometry();
+  };
   if (deterministic()) {
+    pose_now();
     start_mapping_job();
   } else {
     if (options_.sequential) {
@@ -132,6 +136,7 @@ FrameResult System::process(const io::StereoFrame& frame) {
       if (loop_closer_) loop_closer_->process_pending();
     }
     reclaim_culled();
+    pose_now();
   }
   last_timestamp_ = frame.timestamp;
   r.map_size = map_.sizes();

@@ -3,6 +3,8 @@
 // The caller's thread is the tracking thread; local mapping runs concurrently (or, with
 // `sequential`, in the tracking thread after each keyframe, for reproducible runs).
 #include <cstdint>
+
+#include <Eigen/Geometry>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -67,6 +69,10 @@ struct FrameResult {
   tracking::TrackResult track;
   tracking::FrameTimings extraction;
   double tracking_ms = 0;  // images in to pose out
+  // A tracked frame's pose (T_world_leftcam): from its reference keyframe as the map holds it when
+  // process() returns, except in deterministic mode, where local mapping may still be moving that
+  // keyframe then: there as tracking left it, before the keyframe's local mapping.
+  std::optional<Eigen::Isometry3d> T_world_camera;
   // After the frame (and any reclamation it triggered): the map's size and the process's
   // resident memory (-1 where unknown), to see memory and map growth over long runs.
   map::Map::Sizes map_size;
