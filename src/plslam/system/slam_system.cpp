@@ -124,8 +124,11 @@ FrameResult System::process(const io::StereoFrame& frame) {
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
   note_revisit(r.track);
+  // What the frame reports of the map: in deterministic mode before its keyframe's local mapping
+  // starts beside the caller, so that it is the same in every run.
   auto pose_now = [&] {
     if (r.track.tracked) r.T_world_camera = tracking::Tracker::pose_of(tracker_->records().back()).inverse().isometry();
+    r.map_size = map_.sizes();
   };
   if (deterministic()) {
     pose_now();
@@ -139,7 +142,6 @@ FrameResult System::process(const io::StereoFrame& frame) {
     pose_now();
   }
   last_timestamp_ = frame.timestamp;
-  r.map_size = map_.sizes();
   r.rss_mb = core::resident_memory_mb();
   return r;
 }

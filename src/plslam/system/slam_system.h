@@ -73,8 +73,9 @@ struct FrameResult {
   // process() returns, except in deterministic mode, where local mapping may still be moving that
   // keyframe then: there as tracking left it, before the keyframe's local mapping.
   std::optional<Eigen::Isometry3d> T_world_camera;
-  // After the frame (and any reclamation it triggered): the map's size and the process's
-  // resident memory (-1 where unknown), to see memory and map growth over long runs.
+  // After the frame (and any reclamation it triggered; in deterministic mode, before the frame's
+  // keyframe is mapped): the map's size and the process's resident memory (-1 where unknown), to
+  // see memory and map growth over long runs.
   map::Map::Sizes map_size;
   double rss_mb = -1;
 };
