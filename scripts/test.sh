@@ -29,7 +29,7 @@ done
 
 # Under the sanitizers, the long accuracy runs labelled sanitizer_skip in tests/test_lists.cmake are
 # left out (each entry says why, and which test runs its code instead); the ThreadSanitizer stage
-# also leaves out those labelled tsan_skip.
+# also leaves out those labelled tsan_skip, the AddressSanitizer stage those labelled asan_skip.
 # ThreadSanitizer runs the tests whose code under test starts threads of plslam's own: the worker
 # pool and the BA that uses it, the local mapper's thread with its pause and abort
 # (LocalMapperThread), the map snapshot taken beside a writer (MapSnapshotConcurrent), the stereo extraction tasks, the image prefetch thread, synth's
@@ -81,6 +81,6 @@ if [ -n "$tests_regex" ]; then ctest_args+=(-R "$tests_regex"); fi
 if [ "$sanitize" = thread ]; then
   ctest_args+=(-LE 'sanitizer_skip|tsan_skip')
 elif [ -n "$sanitize" ]; then
-  ctest_args+=(-LE sanitizer_skip)
+  ctest_args+=(-LE 'sanitizer_skip|asan_skip')
 fi
 ctest "${ctest_args[@]}"

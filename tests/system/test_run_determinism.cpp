@@ -139,17 +139,19 @@ TEST(RunDeterministic, KittiRunsAreIdenticalToEachOtherAndToSequential) {
   PLSLAM_REQUIRE_SHARED_DATA(data);
   test::TempDir tmp;
   const auto seq = data / "kitti/sequences/06";
-  const std::string extra = " --max-frames 30";
+  const std::string extra = " --max-frames 20";
   const auto a = run_mode(seq, tmp.path() / "a", "--deterministic", extra);
   const auto b = run_mode(seq, tmp.path() / "b", "--deterministic", extra);
-  const auto s = run_mode(seq, tmp.path() / "s", "--sequential", extra);
   ASSERT_FALSE(a.is_null());
   EXPECT_EQ(a["mode"], "deterministic");
   EXPECT_EQ(a, b);
   expect_same_outputs(tmp.path() / "a", tmp.path() / "b", "two --deterministic runs");
-  expect_same_outputs(tmp.path() / "a", tmp.path() / "s", "--deterministic and --sequential", false);
   EXPECT_GT(a["keyframes"].get<int>(), 3);
+#ifndef __SANITIZE_THREAD__  // ThreadSanitizer watches the two runs above; a sequential one has no threads to watch
+  const auto s = run_mode(seq, tmp.path() / "s", "--sequential", extra);
+  expect_same_outputs(tmp.path() / "a", tmp.path() / "s", "--deterministic and --sequential", false);
   EXPECT_EQ(a["local_mapping"]["keyframes_processed"], s["local_mapping"]["keyframes_processed"]);
+#endif
   // Every keyframe gets its local BA (the first two have no window yet).
   EXPECT_EQ(a["local_mapping"]["local_ba_skipped"], 0);
   EXPECT_EQ(a["local_mapping"]["local_ba_runs"].get<int>(), a["local_mapping"]["keyframes_processed"].get<int>() - 2);
