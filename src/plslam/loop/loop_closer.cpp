@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -216,20 +217,7 @@ bool LoopCloser::merge_deferred_global_ba() {
     gba_running_ = false;
   }
   gba_cv_.notify_all();
-  if (!d) return false;
-  if (d->result.aborted || !d->result.usable) {
-    spdlog::info("global BA {}", d->result.usable ? "aborted" : "unusable: " + d->result.message);
-    std::lock_guard lock(stats_mutex_);
-    ++stats_.global_ba_aborted;
-    return false;
-  }
-  GlobalBaMergeStats merged;
-  {
-    std::lock_guard map_lock(map_.update_mutex());
-    merged = merge_global_ba(map_, d->snapshot, d->result);
-  }
-  record_global_ba(merged, d->result, ms_since(d->t0));
-  return true;
+  return d && merge_into_map(d->snapshot, d->result, d->t0);
 }
 
 void LoopCloser::global_ba() {
@@ -240,23 +228,28 @@ void LoopCloser::global_ba() {
     MapperPause pause(mapper_);
     snapshot = snapshot_for_global_ba(map_, options_.global_ba_options);
   }
-  const auto result = run_global_ba(snapshot, options_.global_ba_options, &gba_abort_);
-  if (result.aborted || gba_abort_ || !result.usable) {
+  auto result = run_global_ba(snapshot, options_.global_ba_options, &gba_abort_);
+  result.aborted = result.aborted || gba_abort_;
+  merge_into_map(snapshot, result, t0);
+}
+
+bool LoopCloser::merge_into_map(const GlobalBaSnapshot& snapshot, const optim::BaResult& result,
+                                std::chrono::steady_clock::time_point t0) {
+  if (result.aborted || !result.usable) {
     spdlog::info("global BA {}", result.usable ? "aborted" : "unusable: " + result.message);
     std::lock_guard lock(stats_mutex_);
     ++stats_.global_ba_aborted;
-    return;
+    return false;
   }
   GlobalBaMergeStats merged;
   {
-    MapperPause pause(mapper_);
+    // Deferred, the caller merges with local mapping at rest; otherwise it is held here.
+    std::optional<MapperPause> pause;
+    if (!options_.defer_global_ba_merge) pause.emplace(mapper_);
     std::lock_guard map_lock(map_.update_mutex());
     merged = merge_global_ba(map_, snapshot, result);
   }
-  record_global_ba(merged, result, ms_since(t0));
-}
-
-void LoopCloser::record_global_ba(const GlobalBaMergeStats& merged, const optim::BaResult& result, double ms) {
+  const double ms = ms_since(t0);
   spdlog::info("global BA: {} keyframes, {} points, {} lines, {} iterations, cost {:.4g} -> {:.4g}; merged with {} new "
                "keyframes; {:.0f} ms",
                merged.keyframes, merged.points, merged.lines, result.iterations, result.initial_cost, result.final_cost,
@@ -264,6 +257,7 @@ void LoopCloser::record_global_ba(const GlobalBaMergeStats& merged, const optim:
   std::lock_guard lock(stats_mutex_);
   stats_.global_ba_ms.push_back(ms);
   ++stats_.global_ba_runs;
+  return true;
 }
 
 LoopClosingStats LoopCloser::stats() const {

@@ -6,9 +6,9 @@
 // while local mapping is paused and tracking waits on the map's update lock.
 #include <atomic>
 #include <chrono>
-#include <memory>
 #include <condition_variable>
 #include <deque>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -162,8 +162,10 @@ class LoopCloser {
   void start_deferred_global_ba();
   // Joins the global BA thread, cutting it short; a deferred result not merged yet is dropped.
   void abort_global_ba();
-  // The statistics of a merged global BA.
-  void record_global_ba(const GlobalBaMergeStats& merged, const optim::BaResult& result, double ms);
+  // Writes a global BA's result into the map (unless it was aborted or is unusable, which is
+  // counted) and records it; `t0`: when its snapshot was taken. True if merged.
+  bool merge_into_map(const GlobalBaSnapshot& snapshot, const optim::BaResult& result,
+                      std::chrono::steady_clock::time_point t0);
 
   map::Map& map_;
   const place::KeyframeDatabase& database_;

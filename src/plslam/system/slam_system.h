@@ -3,13 +3,13 @@
 // The caller's thread is the tracking thread; local mapping runs concurrently (or, with
 // `sequential`, in the tracking thread after each keyframe, for reproducible runs).
 #include <cstdint>
-
-#include <Eigen/Geometry>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <thread>
 #include <vector>
+
+#include <Eigen/Geometry>
 
 #include "plslam/core/types.h"
 #include "plslam/io/dataset.h"
