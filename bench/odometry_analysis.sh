@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Odometry analysis on rendered office loops (issue 22): where the error grows and why.
 #
-#   bench/odometry_analysis.sh [--seeds "1 2 3"] [--runs N] [--anchor PATH] [--config FILE] OUT
+#   bench/odometry_analysis.sh [--seeds "1 2 3"] [--runs N] [--anchor PATH] [--config FILE]
+#                              [--deterministic] OUT
 #
 # For each seed: renders `synth --scene office --preset euroc --frames 480 --loop --seed S`, runs
-# plslam once with --sequential (reproducible) and N times in the default concurrent mode, all
+# plslam once with --sequential (reproducible) and N times in the default concurrent mode (with
+# --deterministic: once with --deterministic, whose runs are identical; the anchor still runs N
+# times), all
 # with --no-loop-closing (this measures the odometry: a closed loop would hide its drift), and,
 # with --anchor (e.g. ../shared/anchors/orbslam3/run), the anchor with --no-loop-closing,
 # alternating run by run with plslam. Every plslam run gets `plslam eval --plot --frames`:
@@ -13,13 +16,14 @@
 # run and the median, min and max ATE per seed and system.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seeds="1 2 3" runs=5 anchor="" config=""
+seeds="1 2 3" runs=5 anchor="" config="" mode=concurrent
 while [ $# -gt 1 ]; do
   case "$1" in
     --seeds) seeds=$2; shift 2 ;;
     --runs) runs=$2; shift 2 ;;
     --anchor) anchor=$2; shift 2 ;;
     --config) config="--config $2"; shift 2 ;;
+    --deterministic) mode=deterministic; shift ;;
     *) echo "odometry_analysis.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -52,8 +56,14 @@ for seed in $seeds; do
       "$anchor" "$seq" --out "$a_dir" --no-loop-closing >/dev/null 2>&1
       echo "seed $seed anchor ATE $(ate_of "$seq" "$a_dir")" | tee -a "$summary"
     fi
-    run_dir="$out/seed$seed-concurrent-$i"
-    "$plslam" run "$seq" --no-loop-closing --quiet $config --out "$run_dir" >/dev/null
+    if [ "$mode" = deterministic ]; then
+      [ "$i" -eq 1 ] || continue  # identical runs: one is the measurement
+      run_dir="$out/seed$seed-deterministic"
+      "$plslam" run "$seq" --deterministic --no-loop-closing --quiet $config --out "$run_dir" >/dev/null
+    else
+      run_dir="$out/seed$seed-concurrent-$i"
+      "$plslam" run "$seq" --no-loop-closing --quiet $config --out "$run_dir" >/dev/null
+    fi
     "$plslam" eval --gt "$seq/mav0/synth/left_camera.tum" --est "$run_dir/trajectory.tum" --plot "$run_dir/plots" \
       --frames "$run_dir/frames.csv" >/dev/null 2>&1
     echo "seed $seed plslam ATE $(ate_of "$seq" "$run_dir")" | tee -a "$summary"
@@ -66,3 +76,21 @@ for seed in $seeds; do
     [ "$line" = none ] || echo "seed $seed $sys: $line" | tee -a "$summary"
   done
 done
+# Over the seeds: the median of plslam's per-seed medians against the anchor's, and the seeds where
+# plslam's median is worse than the anchor's median on it.
+python3 - "$summary" <<'PY' | tee -a "$summary"
+import re, statistics as st, sys
+per = {}
+for line in open(sys.argv[1]):
+    m = re.match(r"seed (\d+) (plslam|anchor) ATE ([0-9.eE+-]+)$", line.strip())
+    if m:
+        per.setdefault(m[2], {}).setdefault(int(m[1]), []).append(float(m[3]))
+if "anchor" in per and "plslam" in per:
+    seeds = sorted(set(per["plslam"]) & set(per["anchor"]))
+    p = {s: st.median(per["plslam"][s]) for s in seeds}
+    a = {s: st.median(per["anchor"][s]) for s in seeds}
+    mp, ma = st.median(p.values()), st.median(a.values())
+    worse = [s for s in seeds if p[s] > a[s]]
+    print(f"over {len(seeds)} seeds: plslam median {mp:.4f}, anchor median {ma:.4f}, ratio {mp / ma:.2f}; "
+          f"seeds where plslam is worse than the anchor's median: {worse if worse else 'none'}")
+PY

@@ -100,6 +100,63 @@ TEST(LocalMapperSequential, ProcessPendingRunsTheFullBaWhateverWasRaisedBefore) 
   EXPECT_LT(r.error2(), 1e-4);
 }
 
+// Deterministic mode's pipeline: the keyframe is processed up to its local BA, whose solver reads
+// only its window; the map is untouched until finish_deferred(), which writes the result back and
+// hands the keyframe on. Meanwhile the mapper is neither idle nor pausable (the window points at
+// landmarks that reclamation would free). The result is process_pending()'s, bit for bit.
+TEST(LocalMapperSequential, ADeferredBaWritesNothingUntilFinishedAndEqualsTheImmediateOne) {
+  Row immediate;
+  LocalMapper reference(immediate.m.map, no_culling());
+  reference.insert(immediate.kf[3]);
+  reference.process_pending();
+
+  Row r;
+  LocalMapper mapper(r.m.map, no_culling());
+  std::vector<map::KeyFrame*> handed_on;
+  mapper.set_keyframe_sink([&](map::KeyFrame* kf) { handed_on.push_back(kf); });
+  mapper.insert(r.kf[3]);
+  const geometry::SE3 before = r.kf[2]->pose();
+  mapper.process_pending_deferring_ba();
+  EXPECT_EQ(mapper.queued(), 0u);
+  EXPECT_FALSE(mapper.idle());
+  EXPECT_FALSE(mapper.try_pause());
+  mapper.optimise_deferred_ba();
+  EXPECT_TRUE(r.kf[2]->pose().matrix() == before.matrix()) << "the solver wrote into the map";
+  EXPECT_TRUE(handed_on.empty());
+  EXPECT_TRUE(mapper.stats().local_ba_ms.empty());
+  mapper.finish_deferred();
+  EXPECT_TRUE(mapper.idle());
+  ASSERT_EQ(handed_on.size(), 1u);
+  EXPECT_EQ(handed_on[0], r.kf[3]);
+  EXPECT_EQ(mapper.stats().local_ba_ms.size(), 1u);
+  EXPECT_EQ(mapper.stats().keyframe_ms.size(), 1u);
+  EXPECT_LT(r.error2(), 1e-4);
+  EXPECT_TRUE(r.kf[2]->pose().matrix() == immediate.kf[2]->pose().matrix());
+  for (int w = 0; w < 60; ++w) {
+    ASSERT_TRUE(r.m.point[w]->position() == immediate.m.point[w]->position()) << "point " << w;
+  }
+}
+
+// The next keyframe finishes a deferred one first, so keyframes are mapped in order.
+TEST(LocalMapperSequential, TheNextKeyframeFinishesTheDeferredOneFirst) {
+  Row r;
+  LocalMapper mapper(r.m.map, no_culling());
+  std::vector<map::KeyFrame*> handed_on;
+  mapper.set_keyframe_sink([&](map::KeyFrame* kf) { handed_on.push_back(kf); });
+  mapper.insert(r.kf[2]);
+  mapper.process_pending_deferring_ba();
+  EXPECT_TRUE(handed_on.empty());
+  mapper.insert(r.kf[3]);
+  mapper.process_pending_deferring_ba();
+  ASSERT_EQ(handed_on.size(), 1u);
+  EXPECT_EQ(handed_on[0], r.kf[2]);
+  mapper.process_pending();  // nothing queued: finishes the deferred one
+  ASSERT_EQ(handed_on.size(), 2u);
+  EXPECT_EQ(handed_on[1], r.kf[3]);
+  EXPECT_EQ(mapper.stats().local_ba_ms.size(), 2u);
+  EXPECT_TRUE(mapper.idle());
+}
+
 // Reclamation's seam: try_pause() holds an idle mapper only, and the held mapper takes no keyframe.
 TEST(LocalMapperThread, TryPauseHoldsOnlyAnIdleMapper) {
   Row r;

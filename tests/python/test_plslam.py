@@ -131,12 +131,16 @@ def test_tracking_releases_the_gil(office_short):
     assert sum(during) > 0, during
 
 
-def test_deterministic_tracking_ends_with_the_sequential_trajectory(office_short):
-    """deterministic=True: mapping beside the next frame's extraction; with no loop, the final
-    trajectory is sequential's."""
+def test_deterministic_tracking_is_reproducible_and_with_a_one_frame_lag_sequential(office_short, tmp_path):
+    """deterministic=True: mapping on its own thread, met at frames fixed in advance: two runs
+    are identical; with the local BA met before the next frame (mapping.ba_merge_after_frames: 1)
+    and no loop, the final trajectory is sequential's."""
     ds = plslam.Dataset(str(office_short))
+    lag1 = tmp_path / "lag1.yaml"
+    lag1.write_text("mapping:\n  ba_merge_after_frames: 1\n")
     trajectories = []
-    for kw in ({"deterministic": True}, {"sequential": True}):
+    for kw in ({"deterministic": True}, {"deterministic": True},
+               {"deterministic": True, "config": lag1}, {"sequential": True, "config": lag1}):
         slam = plslam.System(ds.calibration, **kw)
         for t, left, right in (ds[i] for i in range(30)):
             slam.track(left, right, t)
@@ -144,6 +148,7 @@ def test_deterministic_tracking_ends_with_the_sequential_trajectory(office_short
         trajectories.append(slam.trajectory())
     assert trajectories[0].shape == (30, 8)
     assert np.array_equal(trajectories[0], trajectories[1])
+    assert np.array_equal(trajectories[2], trajectories[3])
 
 
 def test_office_loop_poses_equal_the_cli_sequential_run(office_loop, tmp_path):

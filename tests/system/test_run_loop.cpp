@@ -92,9 +92,10 @@ TEST_F(LoopRun, SequentialRunsWithALoopAreIdentical) {
   }
 }
 
-// --deterministic with the loop: the global BA optimises in its own thread and is merged before the
-// first frame 1 s (input time) after the loop's, the same frame in both runs, so the runs are
-// identical, loop closing and global BA included.
+// --deterministic with the loop: the local BAs and the global BA optimise in their own threads and
+// are merged at frames fixed in advance (the global BA before the first frame 1 s of input time
+// after the loop's), the same frames in both runs, so the runs are identical, loop closing and
+// global BA included.
 TEST_F(LoopRun, DeterministicRunsWithALoopAreIdentical) {
   test::TempDir out;
   const auto config = out.path() / "merge.yaml";
@@ -110,7 +111,11 @@ TEST_F(LoopRun, DeterministicRunsWithALoopAreIdentical) {
   const long loop_at = a["loops"][0]["frame"].get<long>();
   EXPECT_GE(merged_at, loop_at + 7);
   EXPECT_LE(merged_at, loop_at + 8);
-  EXPECT_LT(a["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.0095);  // the sequential run's bound
+  // The local BA met two frames after its keyframe costs accuracy at this render's 6.7 Hz (fewer
+  // keyframes: mapping counts as busy while it is in flight): 0.0106-0.0120 m over 1196-1204
+  // features (sequential 0.0068-0.0077; concurrent median 0.0094, p90 0.0116). At 20 Hz it does
+  // not (docs/analysis/deterministic.md). A sanity bound, not the loop's gain.
+  EXPECT_LT(a["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.014);
   EXPECT_EQ(a["local_mapping"]["local_ba_skipped"], 0);
   for (auto* s : {&a, &b}) {
     for (auto& l : (*s)["loops"]) l.erase("correction_ms");  // timings differ

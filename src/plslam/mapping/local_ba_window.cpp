@@ -55,10 +55,8 @@ void write_back_local_ba(const MapBaProblem& window, const optim::BaResult& resu
   }
 }
 
-bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o, const std::atomic<bool>* abort,
-                  bool* aborted) {
-  const MapBaProblem window = local_ba_window(kf, o);
-  if (window.problem.point_observations.empty()) return false;
+optim::BaResult solve_local_ba(const MapBaProblem& window, const map::KeyFrame& kf, const LocalBaOptions& o,
+                               const std::atomic<bool>* abort) {
   optim::BaOptions ba;
   ba.iterations = o.iterations;
   ba.second_pass_iterations = o.second_iterations;
@@ -66,8 +64,10 @@ bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o, con
   ba.linear_solver = optim::BaLinearSolver::kSparseSchur;
   ba.abort = abort;
   const geometry::StereoCamera cam(kf.data().calib);
-  const auto result = optim::local_bundle_adjustment(cam, window.problem, ba);
-  if (aborted) *aborted = result.aborted;
+  return optim::local_bundle_adjustment(cam, window.problem, ba);
+}
+
+bool apply_local_ba(map::Map& map, const MapBaProblem& window, const optim::BaResult& result) {
   if (!result.usable) {
     spdlog::debug("local BA unusable: {}", result.message);
     return false;
@@ -76,6 +76,15 @@ bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o, con
   write_back_local_ba(window, result);
   map.note_change();  // poses and positions moved: readers of snapshots redraw
   return true;
+}
+
+bool run_local_ba(map::Map& map, map::KeyFrame& kf, const LocalBaOptions& o, const std::atomic<bool>* abort,
+                  bool* aborted) {
+  const MapBaProblem window = local_ba_window(kf, o);
+  if (window.problem.point_observations.empty()) return false;
+  const auto result = solve_local_ba(window, kf, o, abort);
+  if (aborted) *aborted = result.aborted;
+  return apply_local_ba(map, window, result);
 }
 
 }  // namespace plslam::mapping

@@ -30,6 +30,15 @@ MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o);
 // update mutex.
 void write_back_local_ba(const MapBaProblem& window, const optim::BaResult& result);
 
+// The solver's step alone: reads only `window`'s arrays, never the map, so it may run beside
+// tracking (deterministic mode). `kf` gives the camera and the scale factor.
+optim::BaResult solve_local_ba(const MapBaProblem& window, const map::KeyFrame& kf, const LocalBaOptions& o,
+                               const std::atomic<bool>* abort = nullptr);
+
+// Writes a usable result back under the map's update mutex and tells snapshot readers; false
+// (logged at debug level) when the result is unusable.
+bool apply_local_ba(map::Map& map, const MapBaProblem& window, const optim::BaResult& result);
+
 // Builds the window of `kf`, optimises it and writes the result back under the map's update
 // mutex. False when there was nothing to optimise or the solver's result was unusable. `abort`
 // (may be null), raised from another thread, stops the solver after its current iteration; the

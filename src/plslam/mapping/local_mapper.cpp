@@ -82,12 +82,13 @@ void LocalMapper::resume() {
 
 bool LocalMapper::idle() const {
   std::lock_guard lock(queue_mutex_);
-  return queue_.empty() && !busy_;
+  return queue_.empty() && !busy_ && !deferred_open_;
 }
 
 bool LocalMapper::try_pause() {
   std::lock_guard lock(queue_mutex_);
-  if (busy_ || !queue_.empty()) return false;
+  // A deferred BA's window points at landmarks that reclamation would free.
+  if (busy_ || !queue_.empty() || deferred_open_) return false;
   ++pauses_;
   return true;
 }
@@ -111,22 +112,68 @@ void LocalMapper::wait_idle() {
   cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || stop_requested_; });
 }
 
-void LocalMapper::process_front(std::unique_lock<std::mutex>& lock) {
+void LocalMapper::process_front(std::unique_lock<std::mutex>& lock, bool defer) {
   map::KeyFrame* kf = queue_.front();
   queue_.pop_front();
   const bool more = !queue_.empty();
   busy_ = true;
   abort_ba_ = false;  // an abort meant for the previous keyframe's BA
   lock.unlock();
-  process(kf, more);
+  finish_deferred_if_any();
+  process(kf, more, defer);
   lock.lock();
   busy_ = false;
   cv_.notify_all();
 }
 
 void LocalMapper::process_pending() {
+  finish_deferred_if_any();
   std::unique_lock lock(queue_mutex_);
   while (!queue_.empty()) process_front(lock);
+}
+
+void LocalMapper::process_pending_deferring_ba() {
+  std::unique_lock lock(queue_mutex_);
+  while (!queue_.empty()) process_front(lock, true);
+}
+
+void LocalMapper::finish_deferred_if_any() {
+  if (!deferred_) return;
+  optimise_deferred_ba();
+  finish_deferred();
+}
+
+void LocalMapper::optimise_deferred_ba() {
+  if (!deferred_ || deferred_->optimised) return;
+  deferred_->optimised = true;
+  if (!deferred_->window) return;
+  const auto t0 = Clock::now();
+  deferred_->result = solve_local_ba(*deferred_->window, *deferred_->kf, options_.ba, &abort_ba_);
+  deferred_->processing_ms += ms_since(t0);
+  deferred_->ba_ms += ms_since(t0);
+}
+
+void LocalMapper::finish_deferred() {
+  if (!deferred_) return;
+  optimise_deferred_ba();
+  Deferred d = std::move(*deferred_);
+  deferred_.reset();
+  {
+    std::lock_guard lock(queue_mutex_);
+    deferred_open_ = false;
+  }
+  const auto t0 = Clock::now();
+  if (d.window && apply_local_ba(map_, *d.window, d.result)) {
+    std::lock_guard lock(stats_mutex_);
+    stats_.local_ba_ms.push_back(d.ba_ms + ms_since(t0));
+    stats_.aborted_local_ba += d.result.aborted;
+  }
+  if (!d.more_waiting) cull_keyframes(d.kf);
+  {
+    std::lock_guard lock(stats_mutex_);
+    stats_.keyframe_ms.push_back(d.processing_ms + ms_since(t0));
+  }
+  if (sink_ && !d.kf->is_bad()) sink_(d.kf);
 }
 
 void LocalMapper::run() {
@@ -142,7 +189,7 @@ void LocalMapper::run() {
   }
 }
 
-void LocalMapper::process(map::KeyFrame* kf, bool more_waiting) {
+void LocalMapper::process(map::KeyFrame* kf, bool more_waiting, bool defer) {
   const auto t0 = Clock::now();
   process_new_keyframe(kf);
   // The bag of words is computed here, off the tracking thread (ORB-SLAM2 does it in local mapping too).
@@ -154,6 +201,9 @@ void LocalMapper::process(map::KeyFrame* kf, bool more_waiting) {
   double fusion_ms = -1;
   const bool ba_due = options_.local_ba && map_.num_keyframes() > 2;
   bool ba_skipped = ba_due && more_waiting;
+  Deferred d;
+  d.kf = kf;
+  d.more_waiting = more_waiting;
   // Like ORB-SLAM2: the expensive steps only when tracking is not waiting with more keyframes.
   if (!more_waiting) {
     t = Clock::now();
@@ -161,17 +211,26 @@ void LocalMapper::process(map::KeyFrame* kf, bool more_waiting) {
     fusion_ms = ms_since(t);
     // An abort raised before the BA starts (a pause, a newer keyframe) skips it.
     ba_skipped = ba_due && abort_ba_;
-    if (ba_due && !ba_skipped) local_bundle_adjustment(kf);
-    cull_keyframes(kf);
+    if (ba_due && !ba_skipped) {
+      t = Clock::now();
+      d.window.emplace(local_ba_window(*kf, options_.ba));
+      d.ba_ms = ms_since(t);
+      if (d.window->problem.point_observations.empty()) d.window.reset();
+    }
   }
+  d.processing_ms = ms_since(t0);
   {
     std::lock_guard lock(stats_mutex_);
     stats_.skipped_local_ba += ba_skipped;
-    stats_.keyframe_ms.push_back(ms_since(t0));
     stats_.triangulation_ms.push_back(triangulation_ms);
     if (fusion_ms >= 0) stats_.fusion_ms.push_back(fusion_ms);
   }
-  if (sink_ && !kf->is_bad()) sink_(kf);
+  deferred_ = std::move(d);
+  {
+    std::lock_guard lock(queue_mutex_);
+    deferred_open_ = true;
+  }
+  if (!defer) finish_deferred();
 }
 
 void LocalMapper::process_new_keyframe(map::KeyFrame* kf) {
@@ -230,15 +289,6 @@ void LocalMapper::fuse(map::KeyFrame* kf) {
   const int fused = fuse_landmarks(*kf, options_.fusion);
   std::lock_guard lock(stats_mutex_);
   stats_.fused_points += fused;
-}
-
-void LocalMapper::local_bundle_adjustment(map::KeyFrame* kf) {
-  const auto t0 = Clock::now();
-  bool aborted = false;
-  if (!run_local_ba(map_, *kf, options_.ba, &abort_ba_, &aborted)) return;
-  std::lock_guard stats_lock(stats_mutex_);
-  stats_.local_ba_ms.push_back(ms_since(t0));
-  stats_.aborted_local_ba += aborted;
 }
 
 void LocalMapper::cull_keyframes(map::KeyFrame* kf) {

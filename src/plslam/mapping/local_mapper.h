@@ -20,6 +20,8 @@
 #include "plslam/mapping/landmark_triangulation.h"
 #include "plslam/mapping/local_ba_window.h"
 
+#include <optional>
+
 namespace plslam::place {
 class KeyframeDatabase;
 }  // namespace plslam::place
@@ -45,6 +47,11 @@ struct LocalMapperOptions {
   // KITTI 06 0.0276/0.0314, KITTI 01 0.566/0.539, all within the runs' spread), so the map keeps
   // the full BAs.
   bool abort_ba_on_new_keyframe = false;
+  // Deterministic mode (System): a keyframe's local BA optimises beside the tracking of the next
+  // frames, and its result enters the map before the frame this many frames after the keyframe's
+  // is tracked, or earlier, before the next keyframe is mapped. 1: before the very next frame
+  // (the map then evolves exactly as in sequential mode).
+  int ba_merge_after_frames = 2;
 };
 
 struct LocalMapperStats {
@@ -106,19 +113,31 @@ class LocalMapper {
   // Blocks until the queue is empty and the current keyframe is done.
   void wait_idle();
 
+  // The deterministic mode's pipeline, in three steps that the system calls at frames it fixes.
+  // process_pending_deferring_ba() processes the queued keyframes like process_pending(), except
+  // that the last one's local BA is only prepared: its window is built (the map is read here).
+  // optimise_deferred_ba() runs the solver, which reads only the window, so it may run in another
+  // thread beside tracking, which then reads a map that nothing writes. finish_deferred() writes
+  // the result back, culls redundant keyframes and hands the keyframe to loop closing. The next
+  // keyframe's processing finishes a deferred one first; so does process_pending().
+  void process_pending_deferring_ba();
+  void optimise_deferred_ba();
+  void finish_deferred();
+
   LocalMapperStats stats() const;
 
  private:
   void run();
   // Pops the front keyframe (lock held), processes it with the lock released, marks idle again.
-  void process_front(std::unique_lock<std::mutex>& lock);
-  void process(map::KeyFrame* kf, bool more_waiting);
+  void process_front(std::unique_lock<std::mutex>& lock, bool defer = false);
+  // With `defer`, stops before the local BA's solver (process_pending_deferring_ba()).
+  void process(map::KeyFrame* kf, bool more_waiting, bool defer);
+  void finish_deferred_if_any();
   // Adds the keyframe's observations of the landmarks tracking associated, and its covisibility
   // edges; the landmarks it made itself go on probation.
   void process_new_keyframe(map::KeyFrame* kf);
   void triangulate(map::KeyFrame* kf);
   void fuse(map::KeyFrame* kf);
-  void local_bundle_adjustment(map::KeyFrame* kf);
   void cull_keyframes(map::KeyFrame* kf);
 
   map::Map& map_;
@@ -137,6 +156,19 @@ class LocalMapper {
 
   // Touched only by the mapping thread (or the caller of process_pending()).
   RecentLandmarks recent_;
+  // A processed keyframe whose last steps wait: its local BA (window empty: none due), its
+  // keyframe culling and its hand-over to loop closing.
+  struct Deferred {
+    map::KeyFrame* kf = nullptr;
+    bool more_waiting = false;
+    std::optional<MapBaProblem> window;
+    optim::BaResult result;
+    bool optimised = false;
+    double processing_ms = 0;  // before the solver, then with it
+    double ba_ms = 0;          // the window's and the solver's
+  };
+  std::optional<Deferred> deferred_;
+  bool deferred_open_ = false;  // deferred_ holds a keyframe; guarded by queue_mutex_ (try_pause)
 
   mutable std::mutex stats_mutex_;
   LocalMapperStats stats_;

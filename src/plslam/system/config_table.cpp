@@ -203,6 +203,10 @@ std::vector<ConfigKey> make_table() {
           "weight of line residuals against point residuals (tracking, local and global BA)", positive()),
 
     field("mapping", "local_ba", [](auto& o) -> auto& { return o.mapper.local_ba; }, "local bundle adjustment"),
+    field("mapping", "ba_merge_after_frames", [](auto& o) -> auto& { return o.mapper.ba_merge_after_frames; },
+          "deterministic mode: a keyframe's local BA enters the map before the frame this many frames later "
+          "is tracked (or before the next keyframe is mapped); 1: before the next frame",
+          at_least(1)),
     field("mapping", "abort_ba_on_new_keyframe", [](auto& o) -> auto& { return o.mapper.abort_ba_on_new_keyframe; },
           "a keyframe queued during local BA cuts it short (mapping thread only)"),
     field("mapping", "ba_iterations", [](auto& o) -> auto& { return o.mapper.ba.iterations; },

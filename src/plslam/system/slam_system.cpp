@@ -92,11 +92,15 @@ System::System(const StereoCalibration& calib, SystemOptions options, std::share
   }
   auto* mapper = mapper_.get();
   // Deterministic mode: tracking reads the map only once mapping has processed every keyframe
-  // queued before, as in sequential mode.
+  // queued before, as in sequential mode; local mapping counts as busy (the keyframe rule's
+  // "mapping idle") while a local BA is in flight, which is fixed by frames, not by timing.
   const bool sequential = options_.sequential || deterministic();
   tracker_ = std::make_unique<tracking::Tracker>(
       map_, options_.tracker, [mapper](map::KeyFrame* kf) { mapper->insert(kf); },
-      [mapper, sequential] { return sequential || mapper->idle(); });
+      [this, mapper, sequential] {
+        if (deterministic()) return !ba_in_flight_;
+        return sequential || mapper->idle();
+      });
   tracker_->set_mapping_queue([mapper, sequential] { return sequential ? std::size_t{0} : mapper->queued(); });
   tracker_->set_keyframe_database(database_.get());
   if (!sequential && !options_.localization_only) {
@@ -116,10 +120,14 @@ FrameResult System::process(const io::StereoFrame& frame) {
   // every later frame (the keyframe policy counts frames by id, the outputs align by it).
   auto data = extractor_.extract(static_cast<long>(frame.index), frame.timestamp, frame.left, frame.right, &r.extraction);
   if (deterministic()) {
-    // The meeting point: the map as the last frame's keyframes left it, whatever the timing.
-    join_mapping_job();
+    // The meeting point: the map as the frames before left it, whatever the timing: the last
+    // keyframe's edits, and the local BAs whose frame has come.
+    const auto tw = std::chrono::steady_clock::now();
+    wait_for_map_edits();
+    if (ba_in_flight_ && static_cast<long>(frame.index) >= ba_due_frame_) finish_local_ba();
+    mapping_waits_.add(ms_since(tw));
     merge_due_global_ba(static_cast<long>(frame.index), frame.timestamp);
-    reclaim_culled();
+    if (!ba_in_flight_) reclaim_culled();
   }
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
@@ -132,7 +140,7 @@ FrameResult System::process(const io::StereoFrame& frame) {
   };
   if (deterministic()) {
     pose_now();
-    start_mapping_job();
+    start_mapping_job(r.frame_id);
   } else {
     if (options_.sequential) {
       mapper_->process_pending();
@@ -192,20 +200,45 @@ void WaitStats::add(double ms) {
 
 bool System::deterministic() const { return options_.deterministic && !options_.sequential; }
 
-void System::start_mapping_job() {
+void System::start_mapping_job(long frame_id) {
   if (mapper_->queued() == 0) return;
-  mapping_job_ = std::thread([this] {
+  std::thread previous = std::move(mapping_job_);
+  const bool finish_previous = ba_in_flight_;
+  {
+    std::lock_guard lock(job_mutex_);
+    job_edits_done_ = false;
+  }
+  mapping_job_ = std::thread([this, previous = std::move(previous), finish_previous]() mutable {
     core::name_this_thread("plslam-mapping");
-    mapper_->process_pending();
-    if (loop_closer_) loop_closer_->process_pending();
+    if (previous.joinable()) previous.join();
+    if (finish_previous) {
+      mapper_->finish_deferred();
+      if (loop_closer_) loop_closer_->process_pending();
+      reclaim_culled();
+    }
+    mapper_->process_pending_deferring_ba();
+    {
+      std::lock_guard lock(job_mutex_);
+      job_edits_done_ = true;
+    }
+    job_cv_.notify_all();
+    mapper_->optimise_deferred_ba();
   });
+  ba_in_flight_ = true;
+  ba_due_frame_ = frame_id + std::max(1, options_.mapper.ba_merge_after_frames);
 }
 
-void System::join_mapping_job() {
-  if (!mapping_job_.joinable()) return;
-  const auto t0 = std::chrono::steady_clock::now();
-  mapping_job_.join();
-  mapping_waits_.add(ms_since(t0));
+void System::wait_for_map_edits() {
+  std::unique_lock lock(job_mutex_);
+  job_cv_.wait(lock, [this] { return job_edits_done_; });
+}
+
+void System::finish_local_ba() {
+  if (mapping_job_.joinable()) mapping_job_.join();
+  if (!ba_in_flight_) return;
+  ba_in_flight_ = false;
+  mapper_->finish_deferred();
+  if (loop_closer_) loop_closer_->process_pending();
 }
 
 void System::merge_due_global_ba(long frame_id, double timestamp) {
@@ -218,6 +251,8 @@ void System::merge_due_global_ba(long frame_id, double timestamp) {
   if (global_ba_merge_at_ < 0 || timestamp < global_ba_merge_at_) return;
   global_ba_merge_at_ = -1;
   const auto t0 = std::chrono::steady_clock::now();
+  // The local BA in flight was built before the global BA's result: it goes in first.
+  finish_local_ba();
   if (loop_closer_->merge_deferred_global_ba()) global_ba_merge_frames_.push_back(frame_id);
   global_ba_waits_.add(ms_since(t0));
 }
@@ -225,7 +260,7 @@ void System::merge_due_global_ba(long frame_id, double timestamp) {
 void System::finish() {
   if (finished_) return;
   finished_ = true;
-  join_mapping_job();
+  finish_local_ba();
   mapper_->wait_idle();
   mapper_->stop();
   if (loop_closer_) {

@@ -2,9 +2,11 @@
 // The SLAM system: frame extraction, the tracker, and the local mapping thread over one map.
 // The caller's thread is the tracking thread; local mapping runs concurrently (or, with
 // `sequential`, in the tracking thread after each keyframe, for reproducible runs).
+#include <condition_variable>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -136,10 +138,14 @@ class System {
   void reclaim_culled();
   // After a relocalization in the same map, asks loop closing for a global BA at the next keyframe.
   void note_revisit(const tracking::TrackResult& track);
-  // Deterministic mode: local mapping and loop closing of what the last frame queued, in
-  // mapping_job_; and the meeting point before the next frame reads the map.
-  void start_mapping_job();
-  void join_mapping_job();
+  // Deterministic mode. start_mapping_job() maps what the frame queued in mapping_job_: it first
+  // finishes the keyframe before (its local BA's result, keyframe culling, loop closing), then
+  // edits the map for the new one and, once the edits are done (wait_for_map_edits(), before the
+  // next frame is tracked), optimises its local BA beside tracking. finish_local_ba() joins the
+  // job and finishes its keyframe in the caller, at the frame mapping.ba_merge_after_frames fixes.
+  void start_mapping_job(long frame_id);
+  void wait_for_map_edits();
+  void finish_local_ba();
   // Deterministic mode: fixes the merge frame of a global BA that started, and merges it there.
   void merge_due_global_ba(long frame_id, double timestamp);
   bool deterministic() const;
@@ -160,6 +166,11 @@ class System {
   bool revisit_pending_ = false;  // relocalized after a loss; its first keyframe asks for a global BA
   ReclaimStats reclaim_stats_;
   std::thread mapping_job_;
+  std::mutex job_mutex_;
+  std::condition_variable job_cv_;
+  bool job_edits_done_ = true;  // guarded by job_mutex_
+  bool ba_in_flight_ = false;   // mapping_job_ holds a keyframe that finish_local_ba() must finish
+  long ba_due_frame_ = -1;      // ... before this frame is tracked
   long seen_global_ba_starts_ = 0;
   double last_timestamp_ = 0;       // the last frame's input time
   double global_ba_merge_at_ = -1;  // input time of the pending global BA's merge (-1: none)
