@@ -211,10 +211,11 @@ void System::start_mapping_job(long frame_id) {
   mapping_job_ = std::thread([this, previous = std::move(previous), finish_previous]() mutable {
     core::name_this_thread("plslam-mapping");
     if (previous.joinable()) previous.join();
+    // Reclamation is left to the meeting points: the caller reads the tracker's local map
+    // (the viewer) while this runs.
     if (finish_previous) {
       mapper_->finish_deferred();
       if (loop_closer_) loop_closer_->process_pending();
-      reclaim_culled();
     }
     mapper_->process_pending_deferring_ba();
     {
