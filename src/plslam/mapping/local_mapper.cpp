@@ -119,7 +119,7 @@ void LocalMapper::process_front(std::unique_lock<std::mutex>& lock, bool defer) 
   busy_ = true;
   abort_ba_ = false;  // an abort meant for the previous keyframe's BA
   lock.unlock();
-  finish_deferred_if_any();
+  finish_deferred();
   process(kf, more, defer);
   lock.lock();
   busy_ = false;
@@ -127,7 +127,7 @@ void LocalMapper::process_front(std::unique_lock<std::mutex>& lock, bool defer) 
 }
 
 void LocalMapper::process_pending() {
-  finish_deferred_if_any();
+  finish_deferred();
   std::unique_lock lock(queue_mutex_);
   while (!queue_.empty()) process_front(lock);
 }
@@ -135,12 +135,6 @@ void LocalMapper::process_pending() {
 void LocalMapper::process_pending_deferring_ba() {
   std::unique_lock lock(queue_mutex_);
   while (!queue_.empty()) process_front(lock, true);
-}
-
-void LocalMapper::finish_deferred_if_any() {
-  if (!deferred_) return;
-  optimise_deferred_ba();
-  finish_deferred();
 }
 
 void LocalMapper::optimise_deferred_ba() {

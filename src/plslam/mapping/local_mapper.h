@@ -10,6 +10,7 @@
 #include <deque>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -19,8 +20,6 @@
 #include "plslam/mapping/landmark_fusion.h"
 #include "plslam/mapping/landmark_triangulation.h"
 #include "plslam/mapping/local_ba_window.h"
-
-#include <optional>
 
 namespace plslam::place {
 class KeyframeDatabase;
@@ -117,8 +116,9 @@ class LocalMapper {
   // process_pending_deferring_ba() processes the queued keyframes like process_pending(), except
   // that the last one's local BA is only prepared: its window is built (the map is read here).
   // optimise_deferred_ba() runs the solver, which reads only the window, so it may run in another
-  // thread beside tracking, which then reads a map that nothing writes. finish_deferred() writes
-  // the result back, culls redundant keyframes and hands the keyframe to loop closing. The next
+  // thread beside tracking, which then reads a map that nothing writes. finish_deferred() (a no-op
+  // when nothing is deferred) optimises if that has not run, writes the result back, culls
+  // redundant keyframes and hands the keyframe to loop closing. The next
   // keyframe's processing finishes a deferred one first; so does process_pending().
   void process_pending_deferring_ba();
   void optimise_deferred_ba();
@@ -132,7 +132,6 @@ class LocalMapper {
   void process_front(std::unique_lock<std::mutex>& lock, bool defer = false);
   // With `defer`, stops before the local BA's solver (process_pending_deferring_ba()).
   void process(map::KeyFrame* kf, bool more_waiting, bool defer);
-  void finish_deferred_if_any();
   // Adds the keyframe's observations of the landmarks tracking associated, and its covisibility
   // edges; the landmarks it made itself go on probation.
   void process_new_keyframe(map::KeyFrame* kf);

@@ -213,10 +213,7 @@ void System::start_mapping_job(long frame_id) {
     if (previous.joinable()) previous.join();
     // Reclamation is left to the meeting points: the caller reads the tracker's local map
     // (the viewer) while this runs.
-    if (finish_previous) {
-      mapper_->finish_deferred();
-      if (loop_closer_) loop_closer_->process_pending();
-    }
+    if (finish_previous) finish_mapped_keyframe();
     mapper_->process_pending_deferring_ba();
     {
       std::lock_guard lock(job_mutex_);
@@ -238,6 +235,10 @@ void System::finish_local_ba() {
   if (mapping_job_.joinable()) mapping_job_.join();
   if (!ba_in_flight_) return;
   ba_in_flight_ = false;
+  finish_mapped_keyframe();
+}
+
+void System::finish_mapped_keyframe() {
   mapper_->finish_deferred();
   if (loop_closer_) loop_closer_->process_pending();
 }

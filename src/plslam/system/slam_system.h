@@ -146,6 +146,9 @@ class System {
   void start_mapping_job(long frame_id);
   void wait_for_map_edits();
   void finish_local_ba();
+  // The last steps of the keyframe whose local BA is in flight: its result and keyframe culling,
+  // then its loop closing (with mapping_job_ joined, or from the next job itself).
+  void finish_mapped_keyframe();
   // Deterministic mode: fixes the merge frame of a global BA that started, and merges it there.
   void merge_due_global_ba(long frame_id, double timestamp);
   bool deterministic() const;
