@@ -165,6 +165,58 @@ TEST(LoopCorrection, KeyframesStillQueuedForLocalMappingMoveWithTheirAnchor) {
   EXPECT_GT(own, 0);
 }
 
+// The deterministic pipeline cuts the correction in three steps (the essential graph solved
+// beside tracking): with nothing done between them, they are correct_loop, bit for bit.
+TEST(LoopCorrection, InThreeStepsIsCorrectLoop) {
+  Scene one, three;
+  for (auto* s : {&one, &three}) {
+    for (int k = 0; k <= kPerLap + 10; ++k) s->add_keyframe(k);
+  }
+  const auto c1 = verify_loop(one.keyframes[kPerLap + 10], one.keyframes[10], *one.db);
+  const auto c3 = verify_loop(three.keyframes[kPerLap + 10], three.keyframes[10], *three.db);
+  ASSERT_TRUE(c1 && c3);
+  const auto r1 = correct_loop(one.map, *c1);
+  auto plan = begin_loop_correction(three.map, *c3);
+  const auto r3 = finish_loop_correction(three.map, plan, solve_essential_graph(plan.problem));
+  ASSERT_TRUE(r1.graph.usable && r3.graph.usable);
+  EXPECT_EQ(r1.fused_points, r3.fused_points);
+  EXPECT_EQ(r1.graph.edges, r3.graph.edges);
+  ASSERT_EQ(one.keyframes.size(), three.keyframes.size());
+  for (std::size_t k = 0; k < one.keyframes.size(); ++k) {
+    EXPECT_EQ(one.keyframes[k]->pose().matrix(), three.keyframes[k]->pose().matrix()) << "keyframe " << k;
+  }
+  const auto p1 = one.map.points(), p3 = three.map.points();
+  ASSERT_EQ(p1.size(), p3.size());
+  for (std::size_t i = 0; i < p1.size(); ++i) EXPECT_EQ(p1[i]->position(), p3[i]->position()) << "point " << i;
+}
+
+// ... and local mapping may work between the first step and the last: a keyframe made in the
+// corrected neighbourhood moves with its parent, and a graph keyframe a local BA moved keeps that
+// change on top of its optimised pose.
+TEST(LoopCorrection, InThreeStepsFollowsWhatLocalMappingDidBetweenThem) {
+  Scene s;
+  for (int k = 0; k <= kPerLap + 10; ++k) s.add_keyframe(k);
+  const auto c = verify_loop(s.keyframes[kPerLap + 10], s.keyframes[10], *s.db);
+  ASSERT_TRUE(c);
+  auto plan = begin_loop_correction(s.map, *c);
+  s.map.note_big_change();  // as LoopCloser does: tracking goes on from the corrected neighbourhood
+  map::KeyFrame* made = s.add_keyframe(kPerLap + 11);
+  map::KeyFrame* nudged = s.keyframes[kPerLap + 9];
+  const geometry::SE3 nudge(Eigen::AngleAxisd(0.001, Eigen::Vector3d::UnitX()).toRotationMatrix(),
+                            Eigen::Vector3d(0.002, 0, 0));
+  nudged->set_pose(nudge * nudged->pose());
+  const auto graph = solve_essential_graph(plan.problem);
+  ASSERT_TRUE(graph.usable);
+  ASSERT_FALSE(graph.poses.count(made));
+  const geometry::SE3 optimised = graph.poses.at(nudged);
+  const auto r = finish_loop_correction(s.map, plan, graph);
+  EXPECT_EQ(r.unmapped_keyframes, 1) << "the keyframe made between the steps";
+  EXPECT_LT(pose_error(nudged->pose(), nudge * optimised).first, 1e-9);
+  EXPECT_LT(pose_error(nudged->pose(), nudge * optimised).second, 1e-7);
+  expect_on_truth(s, "after the three steps");  // the nudge is 2 mm and 0.06 degrees
+  EXPECT_EQ(s.map.big_changes(), 2);
+}
+
 TEST(GlobalBa, MergeKeepsWhatTheMapGainedDuringTheBaAttachedToItsParent) {
   Scene s;
   for (int k = 0; k < 20; ++k) s.add_keyframe(k);

@@ -133,11 +133,12 @@ def test_tracking_releases_the_gil(office_short):
 
 def test_deterministic_tracking_is_reproducible_and_with_a_one_frame_lag_sequential(office_short, tmp_path):
     """deterministic=True: mapping on its own thread, met at frames fixed in advance: two runs
-    are identical; with the local BA met before the next frame (mapping.ba_merge_after_frames: 1)
-    and no loop, the final trajectory is sequential's."""
+    are identical; with the local BA met before the next frame (mapping.ba_merge_after_frames: 1,
+    and ba_merge_ms_per_1000_observations: 0, so not later for a large window) and no loop, the
+    final trajectory is sequential's."""
     ds = plslam.Dataset(str(office_short))
     lag1 = tmp_path / "lag1.yaml"
-    lag1.write_text("mapping:\n  ba_merge_after_frames: 1\n")
+    lag1.write_text("mapping:\n  ba_merge_after_frames: 1\n  ba_merge_ms_per_1000_observations: 0\n")
     trajectories = []
     for kw in ({"deterministic": True}, {"deterministic": True},
                {"deterministic": True, "config": lag1}, {"sequential": True, "config": lag1}):

@@ -92,13 +92,14 @@ TEST(PublicApi, TracksASequenceWithPosesTheTrajectoryAndMapAgreeOn) {
 
 // deterministic: mapping on its own thread, met at frames fixed in advance. track() returns each
 // pose before its keyframe's local mapping (which still runs then), the same in every run; with
-// the local BA met before the next frame (a config file's mapping.ba_merge_after_frames: 1), the
+// the local BA met before the next frame (a config file's mapping.ba_merge_after_frames: 1, and
+// ba_merge_ms_per_1000_observations: 0, so not later for a large window), the
 // final trajectory is sequential's, bit for bit (no loop in 60 frames).
 TEST(PublicApi, DeterministicTrackingIsReproducibleAndWithAOneFrameLagEndsWithTheSequentialTrajectory) {
   const Sequence seq(api_sequence());
   test::TempDir tmp;
   const auto lag1 = tmp.path() / "lag1.yaml";
-  std::ofstream(lag1) << "mapping:\n  ba_merge_after_frames: 1\n";
+  std::ofstream(lag1) << "mapping:\n  ba_merge_after_frames: 1\n  ba_merge_ms_per_1000_observations: 0\n";
   struct Run {
     std::vector<Eigen::Isometry3d> returned;
     Trajectory final;

@@ -5,7 +5,6 @@
 #include <stdexcept>
 #include <utility>
 
-#include "plslam/optim/pose_graph.h"
 
 namespace plslam::loop {
 
@@ -14,39 +13,37 @@ void EssentialGraphOptions::validate() const {
   if (iterations < 1) throw std::invalid_argument("loop.essential_iterations: must be >= 1");
 }
 
-EssentialGraphResult optimize_essential_graph(const EssentialGraphInput& in, const EssentialGraphOptions& o) {
+EssentialGraphProblem build_essential_graph(const EssentialGraphInput& in, const EssentialGraphOptions& o) {
   o.validate();
+  EssentialGraphProblem g;
   map::IdMap<map::KeyFrame, int> index;
-  std::vector<geometry::SE3> poses;
-  std::vector<bool> fixed;
   for (map::KeyFrame* kf : in.keyframes) {
     const auto it = in.initial.find(kf);
     if (it == in.initial.end() || !in.odometry.count(kf)) {
       throw std::invalid_argument("optimize_essential_graph: keyframe " + std::to_string(kf->id()) + " has no pose");
     }
-    index[kf] = static_cast<int>(poses.size());
-    poses.push_back(it->second);
-    fixed.push_back(kf == in.candidate);
+    index[kf] = static_cast<int>(g.poses.size());
+    g.nodes.push_back(kf);
+    g.poses.push_back(it->second);
+    g.fixed.push_back(kf == in.candidate);
   }
-  if (!index.count(in.candidate) && !fixed.empty()) fixed.front() = true;  // some node must hold the gauge
-  std::vector<optim::PoseGraphEdge> edges;
+  if (!index.count(in.candidate) && !g.fixed.empty()) g.fixed.front() = true;  // some node must hold the gauge
   std::set<std::pair<long, long>> linked;  // by ids, lower first
   auto add = [&](map::KeyFrame* a, map::KeyFrame* b, const map::IdMap<map::KeyFrame, geometry::SE3>& from) {
     const auto ia = index.find(a), ib = index.find(b);
     if (ia == index.end() || ib == index.end() || a == b) return false;
     if (!linked.emplace(std::min(a->id(), b->id()), std::max(a->id(), b->id())).second) return false;
-    edges.push_back({ia->second, ib->second, (from.at(a) * from.at(b).inverse()).normalized(),
-                     geometry::Matrix6d::Identity()});
+    g.edges.push_back({ia->second, ib->second, (from.at(a) * from.at(b).inverse()).normalized(),
+                       geometry::Matrix6d::Identity()});
     return true;
   };
-  EssentialGraphResult r;
   // New loop connections first, with the corrected poses: they carry the loop. Weak ones are left
   // out, except the pair that was verified.
   for (const auto& [kf, others] : in.loop_connections) {
     for (map::KeyFrame* other : others) {
       const bool verified = (kf == in.query && other == in.candidate) || (kf == in.candidate && other == in.query);
       if (!verified && kf->weight(other) < o.min_covisibility_weight) continue;
-      if (add(kf, other, in.initial)) ++r.loop_edges;
+      if (add(kf, other, in.initial)) ++g.loop_edges;
     }
   }
   // The old structure, with odometry's relative poses.
@@ -58,15 +55,25 @@ EssentialGraphResult optimize_essential_graph(const EssentialGraphInput& in, con
       add(kf, c, in.odometry);
     }
   }
-  r.edges = static_cast<int>(edges.size());
+  return g;
+}
+
+EssentialGraphResult solve_essential_graph(const EssentialGraphProblem& g, const EssentialGraphOptions& o) {
+  EssentialGraphResult r;
+  r.loop_edges = g.loop_edges;
+  r.edges = static_cast<int>(g.edges.size());
   optim::PoseGraphOptions po;
   po.iterations = o.iterations;
-  const auto res = optim::optimize_pose_graph(poses, fixed, edges, po);
+  const auto res = optim::optimize_pose_graph(g.poses, g.fixed, g.edges, po);
   r.usable = res.usable;
   r.initial_cost = res.initial_cost;
   r.final_cost = res.final_cost;
-  for (const auto& [kf, i] : index) r.poses[kf] = res.poses[static_cast<std::size_t>(i)];
+  for (std::size_t i = 0; i < g.nodes.size(); ++i) r.poses[g.nodes[i]] = res.poses[i];
   return r;
+}
+
+EssentialGraphResult optimize_essential_graph(const EssentialGraphInput& in, const EssentialGraphOptions& o) {
+  return solve_essential_graph(build_essential_graph(in, o), o);
 }
 
 }  // namespace plslam::loop

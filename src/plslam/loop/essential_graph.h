@@ -9,6 +9,7 @@
 #include "plslam/geometry/se3.h"
 #include "plslam/map/by_id.h"
 #include "plslam/map/keyframe.h"
+#include "plslam/optim/pose_graph.h"
 
 namespace plslam::loop {
 
@@ -37,7 +38,21 @@ struct EssentialGraphResult {
   bool usable = false;
 };
 
+// The graph as plain data: what the solver needs, and nothing that points into the map except the
+// node order, so it may be solved beside threads that edit the map (deterministic mode).
+struct EssentialGraphProblem {
+  std::vector<map::KeyFrame*> nodes;  // node i's keyframe (only to read the result back)
+  std::vector<geometry::SE3> poses;   // where the optimisation starts
+  std::vector<bool> fixed;
+  std::vector<optim::PoseGraphEdge> edges;
+  int loop_edges = 0;
+};
+
 // Reads the graph (parents, loop edges, covisibility weights); writes nothing to the map.
+EssentialGraphProblem build_essential_graph(const EssentialGraphInput& input, const EssentialGraphOptions& options = {});
+// Reads only `problem`.
+EssentialGraphResult solve_essential_graph(const EssentialGraphProblem& problem, const EssentialGraphOptions& options = {});
+// Both, in one step.
 EssentialGraphResult optimize_essential_graph(const EssentialGraphInput& input, const EssentialGraphOptions& options = {});
 
 }  // namespace plslam::loop

@@ -21,6 +21,9 @@ namespace {
 
 // How much lower the loop-closing and global-BA threads run than tracking and local mapping.
 constexpr int kBackgroundNice = 5;
+// The deterministic pipeline's global BA has seconds until its merge (loop.global_ba_merge_after_s):
+// it takes what tracking and local mapping leave, so that they keep real time beside it.
+constexpr int kDeferredGlobalBaNice = 19;
 
 // Local mapping stays paused while this lives.
 class MapperPause {
@@ -71,6 +74,9 @@ void LoopClosingOptions::validate() const {
   global_ba_options.validate();
   if (!(finish_wait_s >= 0)) throw std::invalid_argument("loop.finish_wait_s: must be >= 0");
   if (!(global_ba_merge_after_s >= 0)) throw std::invalid_argument("loop.global_ba_merge_after_s: must be >= 0");
+  if (correction_merge_after_frames < 1) {
+    throw std::invalid_argument("loop.correction_merge_after_frames: must be >= 1");
+  }
 }
 
 LoopCloser::LoopCloser(map::Map& map, const place::KeyframeDatabase& database, mapping::LocalMapper& mapper,
@@ -83,6 +89,7 @@ LoopCloser::LoopCloser(map::Map& map, const place::KeyframeDatabase& database, m
 LoopCloser::~LoopCloser() {
   stop();
   abort_global_ba();
+  if (graph_thread_.joinable()) graph_thread_.join();
 }
 
 void LoopCloser::start() {
@@ -114,7 +121,8 @@ void LoopCloser::global_ba_after_keyframe(long keyframe_id, long before_loss_key
 
 bool LoopCloser::try_pause() {
   std::lock_guard lock(queue_mutex_);
-  if (busy_ || !queue_.empty()) return false;
+  // A loop waiting for its correction holds keyframes and landmarks that reclamation would free.
+  if (busy_ || !queue_.empty() || pending_loop_ || open_correction_) return false;
   {
     std::lock_guard gba_lock(gba_mutex_);
     if (gba_running_) return false;
@@ -153,6 +161,7 @@ void LoopCloser::wait_idle() {
 
 bool LoopCloser::finish() {
   wait_idle();
+  settle_deferred_steps();
   std::unique_lock lock(gba_mutex_);
   const bool deferred = options_.defer_global_ba_merge;
   const bool done = gba_cv_.wait_for(lock, std::chrono::duration<double>(options_.finish_wait_s),
@@ -197,7 +206,7 @@ void LoopCloser::start_deferred_global_ba() {
   }
   ++gba_starts_;
   gba_thread_ = std::thread([this, d = deferred_.get()] {
-    core::lower_this_thread_priority(kBackgroundNice);
+    core::lower_this_thread_priority(kDeferredGlobalBaNice);
     core::name_this_thread("plslam-gba");
     d->result = run_global_ba(d->snapshot, options_.global_ba_options, &gba_abort_);
     {
@@ -385,13 +394,17 @@ void LoopCloser::process(map::KeyFrame* kf) {
   // Tracking may have asked again meanwhile (a second relocalization): that one waits for its own
   // keyframe.
   if (!revisit_keyframe_.compare_exchange_strong(revisit, -1)) return;
-  if (loop_closed) return;  // the loop started its own global BA
+  if (loop_closed) return;  // the loop starts its own global BA
   const long before = revisit_from_.exchange(-1);
   if (before >= 0 && close_loop_across_relocalization(kf, before)) return;
   spdlog::info("global BA after the relocalized revisit: keyframe {} (frame {})", kf->id(), kf->frame_id());
   {
     std::lock_guard lock(stats_mutex_);
     ++stats_.global_ba_after_relocalization;
+  }
+  if (options_.defer_loop_correction) {
+    gba_requested_ = true;  // the caller starts it where nothing writes the map
+    return;
   }
   abort_global_ba();  // an older one's snapshot predates the revisit
   start_global_ba();
@@ -401,7 +414,7 @@ bool LoopCloser::close_loop(map::KeyFrame* kf) {
   if (kf->is_bad()) return false;
   // A loop corrected while this keyframe waited in the queue may have fused its points into the
   // place's: its covisibility must say so before the detector and the guard below read it.
-  if (map_.big_changes() > 0) kf->update_connections();
+  if (map_.big_changes() > 0 && !options_.defer_loop_correction) kf->update_connections();
   const auto detections = detector_.detect(kf);
   if (detections.empty()) return false;
   if (last_loop_keyframe_ >= 0 && kf->id() < last_loop_keyframe_ + options_.keyframes_between_loops) return false;
@@ -488,36 +501,122 @@ bool LoopCloser::close_loop_across_relocalization(map::KeyFrame* kf, long before
 
 void LoopCloser::correct(const LoopConstraint& loop, map::KeyFrame* newest) {
   map::KeyFrame* kf = loop.query;
+  detector_.reset();
+  last_loop_keyframe_ = std::max(kf->id(), newest->id());
+  if (options_.defer_loop_correction) {
+    pending_loop_ = loop;
+    return;
+  }
   abort_global_ba();  // its snapshot predates this loop
   const auto t0 = std::chrono::steady_clock::now();
-  LoopCorrectionResult corrected;
+  LoopCorrectionResult result;
   {
     std::lock_guard map_lock(map_.update_mutex());
-    corrected = correct_loop(map_, loop, options_.correction);
+    result = correct_loop(map_, loop, options_.correction);
     // A loop into an anchored segment brings a new segment's keyframes into the map's frame.
     map_.tie_segments(kf->segment(), loop.candidate->segment());
   }
-  const double ms = ms_since(t0);
-  detector_.reset();
-  last_loop_keyframe_ = std::max(kf->id(), newest->id());
+  corrected(loop, result, ms_since(t0));
+}
+
+std::size_t LoopCloser::queued() const {
+  std::lock_guard lock(queue_mutex_);
+  return queue_.size();
+}
+
+void LoopCloser::refresh_queued_connections() {
+  if (map_.big_changes() == 0) return;
+  std::lock_guard lock(queue_mutex_);
+  for (map::KeyFrame* kf : queue_) {
+    if (!kf->is_bad()) kf->update_connections();
+  }
+}
+
+void LoopCloser::start_requested_global_ba() {
+  if (!gba_requested_) return;
+  gba_requested_ = false;
+  abort_global_ba();  // an older one's snapshot predates the revisit
+  start_global_ba();
+}
+
+void LoopCloser::begin_deferred_correction() {
+  if (!pending_loop_) return;
+  const LoopConstraint loop = std::move(*pending_loop_);
+  pending_loop_.reset();
+  if (loop.query->is_bad() || loop.candidate->is_bad()) {
+    spdlog::info("loop dropped before its correction: keyframe {} or {} was culled meanwhile", loop.query->id(),
+                 loop.candidate->id());
+    return;
+  }
+  abort_global_ba();  // its snapshot predates this loop
+  gba_requested_ = false;  // ... and so would one asked for before it
+  const auto t0 = std::chrono::steady_clock::now();
+  auto open = std::make_unique<OpenCorrection>();
+  open->loop = loop;
+  {
+    std::lock_guard map_lock(map_.update_mutex());
+    open->plan = begin_loop_correction(map_, loop, options_.correction);
+    map_.note_big_change();  // tracking's last frame moves with its reference keyframe
+  }
+  open->begin_ms = ms_since(t0);
+  open_correction_ = std::move(open);
+  graph_thread_ = std::thread([this, o = open_correction_.get()] {
+    core::name_this_thread("plslam-graph");
+    const auto t = std::chrono::steady_clock::now();
+    o->graph = solve_essential_graph(o->plan.problem, options_.correction.graph);
+    o->graph_ms = ms_since(t);
+  });
+}
+
+void LoopCloser::finish_deferred_correction() {
+  if (!open_correction_) return;
+  graph_thread_.join();
+  auto open = std::move(open_correction_);
+  abort_global_ba();  // one a revisit asked for meanwhile predates this loop's end
+  const auto t0 = std::chrono::steady_clock::now();
+  LoopCorrectionResult result;
+  {
+    std::lock_guard map_lock(map_.update_mutex());
+    result = finish_loop_correction(map_, open->plan, std::move(open->graph));
+    map_.tie_segments(open->loop.query->segment(), open->loop.candidate->segment());
+  }
+  const double ms = open->begin_ms + ms_since(t0);
+  spdlog::debug("loop correction beside tracking: {:.0f} ms to begin, essential graph {:.0f} ms in its thread, "
+                "{:.0f} ms to finish", open->begin_ms, open->graph_ms, ms - open->begin_ms);
+  corrected(open->loop, result, ms);
+}
+
+void LoopCloser::settle_deferred_steps() {
+  begin_deferred_correction();
+  finish_deferred_correction();
+  start_requested_global_ba();
+}
+
+void LoopCloser::corrected(const LoopConstraint& loop, const LoopCorrectionResult& result, double ms) {
+  map::KeyFrame* kf = loop.query;
   LoopRecord rec;
   rec.frame = kf->frame_id();
   rec.keyframe = kf->id();
   rec.matched_keyframe = loop.candidate->id();
   rec.matched_frame = loop.candidate->frame_id();
   rec.inliers = loop.inliers;
-  rec.fused_points = corrected.fused_points;
-  rec.fused_lines = corrected.fused_lines;
+  rec.fused_points = result.fused_points;
+  rec.fused_lines = result.fused_lines;
   rec.correction_ms = ms;
   spdlog::info("loop closed: frame {} (keyframe {}) -> frame {} (keyframe {}), {} inliers, fused {} points and {} "
                "lines, {} loop edges, {} keyframes still queued for mapping moved along, {:.0f} ms",
                rec.frame, rec.keyframe, rec.matched_frame, rec.matched_keyframe, rec.inliers, rec.fused_points,
-               rec.fused_lines, corrected.graph.loop_edges, corrected.unmapped_keyframes, ms);
+               rec.fused_lines, result.graph.loop_edges, result.unmapped_keyframes, ms);
   {
     std::lock_guard lock(stats_mutex_);
     stats_.loops.push_back(rec);
   }
-  if (options_.global_ba) start_global_ba();
+  if (!options_.global_ba) return;
+  if (options_.defer_loop_correction) {
+    gba_requested_ = true;  // the caller starts it at its next step
+    return;
+  }
+  start_global_ba();
 }
 
 void LoopCloser::start_global_ba() {

@@ -10,6 +10,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -74,6 +75,15 @@ struct LoopClosingOptions {
   // keyframe started it (tracking waits there if the optimisation is not done). Long enough for
   // the optimisation to finish beside tracking and mapping on 2 cores, so no frame waits.
   double global_ba_merge_after_s = 3.0;
+  // The deterministic pipeline's loop closing: process_pending() (beside tracking) detects and
+  // verifies only, and never writes the map; the caller then, at frames fixed in advance, begins a
+  // verified loop's correction (the query's neighbourhood onto the place, fusion), leaves its
+  // essential graph to a thread, and finishes it (the rest of the map; the global BA starts),
+  // and starts a global BA asked for by a relocalized revisit.
+  bool defer_loop_correction = false;
+  // ... the correction's end: this many frames after its beginning (tracking waits there if the
+  // essential graph is not solved yet).
+  int correction_merge_after_frames = 2;
   // Throws std::invalid_argument naming the bad field.
   void validate() const;
 };
@@ -131,6 +141,18 @@ class LoopCloser {
   // or it was dropped or unusable. Call from the thread that calls process_pending().
   long global_ba_starts() const { return gba_starts_; }
   bool merge_deferred_global_ba();
+  // defer_loop_correction, called where no other thread reads or writes the map, in this order:
+  // keyframes waiting for process_pending(): their covisibility after a correction or a global BA
+  // changed the map (which process_pending() would otherwise update, beside tracking's reads);
+  // then the deferred steps, and whether one is waiting.
+  std::size_t queued() const;
+  void refresh_queued_connections();
+  bool global_ba_requested() const { return gba_requested_; }
+  void start_requested_global_ba();  // aborts a running one
+  bool loop_pending() const { return pending_loop_.has_value(); }
+  void begin_deferred_correction();
+  bool correction_open() const { return open_correction_ != nullptr; }
+  void finish_deferred_correction();  // waits for the essential graph
   // Holds loop closing only if idle: nothing queued or in progress, no global BA running; true if
   // it did (resume() after). For Map::reclaim(), which needs every thread at rest.
   bool try_pause();
@@ -147,8 +169,13 @@ class LoopCloser {
   // The loop across a relocalization (loop_across_relocalization): `before` is the query, the
   // revisit's keyframe `kf` the place. True if a loop was closed.
   bool close_loop_across_relocalization(map::KeyFrame* kf, long before_id);
-  // Correction, records and global BA of a confirmed loop; `newest` is the latest keyframe involved.
+  // Correction, records and global BA of a confirmed loop; `newest` is the latest keyframe involved
+  // (defer_loop_correction: the loop waits for begin_deferred_correction()).
   void correct(const LoopConstraint& loop, map::KeyFrame* newest);
+  // The log line and the statistics of a corrected loop, and its global BA.
+  void corrected(const LoopConstraint& loop, const LoopCorrectionResult& result, double ms);
+  // The deferred steps of defer_loop_correction, at the end of a run.
+  void settle_deferred_steps();
   // Verification and the projection check; the constraint to correct with, if the place holds.
   // `path_from`: the keyframe id the drift is counted from (-1: the candidate's).
   std::optional<LoopConstraint> confirm(map::KeyFrame* kf, const LoopDetection& d, const LoopVerifierOptions& verifier,
@@ -197,6 +224,19 @@ class LoopCloser {
     std::chrono::steady_clock::time_point t0;
   };
   std::unique_ptr<Deferred> deferred_;  // written by gba_thread_ until it is joined
+
+  // defer_loop_correction: written by process_pending(), read by the caller's deferred steps.
+  bool gba_requested_ = false;
+  std::optional<LoopConstraint> pending_loop_;  // verified, its correction not begun
+  struct OpenCorrection {
+    LoopConstraint loop;
+    LoopCorrectionPlan plan;
+    EssentialGraphResult graph;  // written by graph_thread_ until it is joined
+    double begin_ms = 0;
+    double graph_ms = 0;
+  };
+  std::unique_ptr<OpenCorrection> open_correction_;
+  std::thread graph_thread_;
 
   mutable std::mutex stats_mutex_;
   LoopClosingStats stats_;

@@ -13,11 +13,16 @@ using map::KeyFrame;
 using map::MapLine;
 using map::MapPoint;
 
+bool same_pose(const geometry::SE3& a, const geometry::SE3& b) {
+  return a.rotation() == b.rotation() && a.translation() == b.translation();
+}
+
 // The keyframe a landmark moves with: the one that corrected it, else its reference, else any
 // good observer (a culled reference).
 template <class L>
 KeyFrame* anchor_of(L* l, const IdMap<L, KeyFrame*>& corrected_by, const IdMap<KeyFrame, geometry::SE3>& poses) {
-  if (const auto it = corrected_by.find(l); it != corrected_by.end()) return it->second;
+  // (A correction finished beside local mapping: the keyframe that corrected it may be culled since.)
+  if (const auto it = corrected_by.find(l); it != corrected_by.end() && poses.count(it->second)) return it->second;
   KeyFrame* ref = l->reference();
   if (ref && !ref->is_bad() && poses.count(ref)) return ref;
   for (const auto& [kf, idx] : l->observation_list()) {
@@ -42,18 +47,25 @@ std::vector<L*> place_landmarks(const std::vector<KeyFrame*>& place, std::vector
 }  // namespace
 
 LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, const LoopCorrectionOptions& o) {
+  auto plan = begin_loop_correction(map, loop, o);
+  return finish_loop_correction(map, plan, solve_essential_graph(plan.problem, o.graph));
+}
+
+LoopCorrectionPlan begin_loop_correction(map::Map& map, const LoopConstraint& loop, const LoopCorrectionOptions& o) {
   o.graph.validate();
-  LoopCorrectionResult r;
+  LoopCorrectionPlan plan;
+  LoopCorrectionResult& r = plan.result;
+  EssentialGraphInput& graph = plan.graph;
   KeyFrame* query = loop.query;
   KeyFrame* candidate = loop.candidate;
   query->update_connections();
 
   // 1. Poses before the correction, and the query's neighbourhood moved by the verified pose.
-  EssentialGraphInput graph;
   auto [connected, unmapped] = split_unmapped(map.keyframes());
   graph.keyframes = std::move(connected);
+  plan.unmapped = std::move(unmapped);
   for (KeyFrame* kf : graph.keyframes) graph.odometry[kf] = graph.initial[kf] = kf->pose();
-  for (const auto& u : unmapped) graph.odometry[u.keyframe] = graph.initial[u.keyframe] = u.keyframe->pose();
+  for (const auto& u : plan.unmapped) graph.odometry[u.keyframe] = graph.initial[u.keyframe] = u.keyframe->pose();
   graph.query = query;
   graph.candidate = candidate;
   std::vector<KeyFrame*> neighbourhood{query};
@@ -68,8 +80,8 @@ LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, con
   r.neighbourhood = static_cast<int>(neighbourhood.size());
 
   // 2. Their landmarks, each with the first neighbourhood keyframe that sees it.
-  IdMap<MapPoint, KeyFrame*> point_corrected_by;
-  IdMap<MapLine, KeyFrame*> line_corrected_by;
+  auto& point_corrected_by = plan.point_corrected_by;
+  auto& line_corrected_by = plan.line_corrected_by;
   for (KeyFrame* kf : neighbourhood) {
     const geometry::SE3 M = graph.initial.at(kf).inverse() * graph.odometry.at(kf);  // old world -> corrected world
     for (MapPoint* p : kf->map_points()) {
@@ -160,29 +172,56 @@ LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, con
   }
   graph.loop_connections[query].insert(candidate);
 
-  // 5. The essential graph, then every landmark with its anchor keyframe.
-  r.graph = optimize_essential_graph(graph, o.graph);
+  // 5. The essential graph, solved by the caller.
+  plan.problem = build_essential_graph(graph, o.graph);
+  return plan;
+}
+
+LoopCorrectionResult finish_loop_correction(map::Map& map, LoopCorrectionPlan& plan, EssentialGraphResult solved) {
+  LoopCorrectionResult& r = plan.result;
+  const EssentialGraphInput& graph = plan.graph;
+  r.graph = std::move(solved);
   if (!r.graph.usable) return r;
-  for (const auto& [kf, anchor] : unmapped) {
+  for (const auto& [kf, anchor] : plan.unmapped) {
     r.graph.poses[kf] = (graph.odometry.at(kf) * graph.odometry.at(anchor).inverse() * r.graph.poses.at(anchor)).normalized();
     ++r.unmapped_keyframes;
   }
-  for (const auto& [kf, T] : r.graph.poses) kf->set_pose(T);
-  // A landmark's anchor moved from `initial` to the optimised pose; it keeps its place in the
-  // anchor's camera frame.
-  auto motion_of = [&](KeyFrame* anchor) {
-    return (r.graph.poses.at(anchor).inverse() * graph.initial.at(anchor)).normalized();
-  };
+  // Where each keyframe is now and where it goes. A keyframe of the graph that local mapping moved
+  // since the first step keeps that change on top of its optimised pose; one made since moves with
+  // its parent (or the latest keyframe before it), as an unmapped one does.
+  IdMap<KeyFrame, geometry::SE3> before, after;
+  KeyFrame* latest = nullptr;
+  for (KeyFrame* kf : map.keyframes()) {
+    if (kf->is_bad()) continue;
+    const geometry::SE3 now = kf->pose();
+    before[kf] = now;
+    if (const auto it = r.graph.poses.find(kf); it != r.graph.poses.end()) {
+      const geometry::SE3& start = graph.initial.at(kf);
+      after[kf] = same_pose(now, start) ? it->second : (now * start.inverse() * it->second).normalized();
+      latest = kf;
+      continue;
+    }
+    KeyFrame* anchor = kf->parent() && after.count(kf->parent()) ? kf->parent() : latest;
+    if (!anchor) continue;
+    const geometry::SE3 motion = (after.at(anchor).inverse() * before.at(anchor)).normalized();
+    after[kf] = (now * motion.inverse()).normalized();
+    ++r.unmapped_keyframes;
+  }
+  for (const auto& [kf, T] : after) kf->set_pose(T);
+  // A landmark's anchor moved from `before` to `after`; it keeps its place in the anchor's camera frame.
+  auto motion_of = [&](KeyFrame* anchor) { return (after.at(anchor).inverse() * before.at(anchor)).normalized(); };
+  const auto& point_corrected_by = plan.point_corrected_by;
+  const auto& line_corrected_by = plan.line_corrected_by;
   for (MapPoint* p : map.points()) {
     if (p->is_bad()) continue;
-    KeyFrame* anchor = anchor_of(p, point_corrected_by, r.graph.poses);
+    KeyFrame* anchor = anchor_of(p, point_corrected_by, after);
     if (!anchor) continue;
     p->set_position(motion_of(anchor) * p->position());
     p->update_normal_and_depth();
   }
   for (MapLine* l : map.lines()) {
     if (l->is_bad()) continue;
-    KeyFrame* anchor = anchor_of(l, line_corrected_by, r.graph.poses);
+    KeyFrame* anchor = anchor_of(l, line_corrected_by, after);
     if (!anchor) continue;
     const geometry::SE3 M = motion_of(anchor);
     l->set_endpoints(M * l->start(), M * l->end());
@@ -190,8 +229,8 @@ LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, con
   }
 
   // 6. The loop edge, kept for every later essential graph.
-  query->add_loop_edge(candidate);
-  candidate->add_loop_edge(query);
+  graph.query->add_loop_edge(graph.candidate);
+  graph.candidate->add_loop_edge(graph.query);
   map.note_big_change();
   return r;
 }

@@ -6,6 +6,7 @@
 // error over the rest of the map, and every other landmark moves with the keyframe it is anchored to.
 #include "plslam/loop/essential_graph.h"
 #include "plslam/loop/loop_verifier.h"
+#include "plslam/loop/unmapped_keyframes.h"
 #include "plslam/map/map.h"
 #include "plslam/mapping/keyframe_projection.h"
 
@@ -32,5 +33,24 @@ struct LoopCorrectionResult {
 // Call with local mapping paused and the map's update lock held: tracking must not see the map
 // between the first pose written and the last landmark moved.
 LoopCorrectionResult correct_loop(map::Map& map, const LoopConstraint& loop, const LoopCorrectionOptions& options = {});
+
+// correct_loop in three steps, for the deterministic pipeline, where the essential graph is solved
+// beside tracking and local mapping. The first moves the query's neighbourhood onto the place,
+// fuses and connects (map lock held); the second is the solver alone, reading only the plan's
+// problem; the third moves the rest of the map (map lock held). Between the first and the third,
+// local mapping may have moved keyframes of the graph (each then keeps its local change on top of
+// the optimised pose) and added keyframes and landmarks (each moves with the keyframe it was made
+// from). Landmarks and keyframes the plan holds must stay allocated until the third step.
+struct LoopCorrectionPlan {
+  EssentialGraphInput graph;
+  EssentialGraphProblem problem;
+  std::vector<UnmappedKeyFrame> unmapped;
+  map::IdMap<map::MapPoint, map::KeyFrame*> point_corrected_by;
+  map::IdMap<map::MapLine, map::KeyFrame*> line_corrected_by;
+  LoopCorrectionResult result;  // the counts of the first step
+};
+LoopCorrectionPlan begin_loop_correction(map::Map& map, const LoopConstraint& loop, const LoopCorrectionOptions& options = {});
+// Returns plan.result with the graph's result; unusable: the map keeps the first step's edits.
+LoopCorrectionResult finish_loop_correction(map::Map& map, LoopCorrectionPlan& plan, EssentialGraphResult graph);
 
 }  // namespace plslam::loop

@@ -147,6 +147,12 @@ void LocalMapper::optimise_deferred_ba() {
   deferred_->ba_ms += ms_since(t0);
 }
 
+std::size_t LocalMapper::deferred_ba_observations() const {
+  if (!deferred_ || !deferred_->window) return 0;
+  const auto& problem = deferred_->window->problem;
+  return problem.point_observations.size() + problem.line_observations.size();
+}
+
 void LocalMapper::finish_deferred() {
   if (!deferred_) return;
   optimise_deferred_ba();

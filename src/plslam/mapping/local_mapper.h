@@ -51,6 +51,11 @@ struct LocalMapperOptions {
   // is tracked, or earlier, before the next keyframe is mapped. 1: before the very next frame
   // (the map then evolves exactly as in sequential mode).
   int ba_merge_after_frames = 2;
+  // ... and not before the frame whose input time is this many ms per 1000 observations of the BA's
+  // window after the keyframe's: the solver's time grows with them (on the machine this was set
+  // on, about 2.2 ms per 1000 alone, more beside tracking), and a window after a loop has twice
+  // the usual. 0: by frames only.
+  double ba_merge_ms_per_1000_observations = 3.0;
 };
 
 struct LocalMapperStats {
@@ -123,6 +128,8 @@ class LocalMapper {
   void process_pending_deferring_ba();
   void optimise_deferred_ba();
   void finish_deferred();
+  // Point and line observations in the deferred BA's window (0: none). From the thread that made it.
+  std::size_t deferred_ba_observations() const;
 
   LocalMapperStats stats() const;
 

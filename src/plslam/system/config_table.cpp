@@ -207,6 +207,11 @@ std::vector<ConfigKey> make_table() {
           "deterministic mode: a keyframe's local BA enters the map before the frame this many frames later "
           "is tracked (or before the next keyframe is mapped); 1: before the next frame",
           at_least(1)),
+    field("mapping", "ba_merge_ms_per_1000_observations",
+          [](auto& o) -> auto& { return o.mapper.ba_merge_ms_per_1000_observations; },
+          "deterministic mode: ... and not before the frame this many ms (input time) per 1000 observations "
+          "of its window after the keyframe's (a large window, after a loop, needs longer); 0: frames only",
+          at_least(0)),
     field("mapping", "abort_ba_on_new_keyframe", [](auto& o) -> auto& { return o.mapper.abort_ba_on_new_keyframe; },
           "a keyframe queued during local BA cuts it short (mapping thread only)"),
     field("mapping", "ba_iterations", [](auto& o) -> auto& { return o.mapper.ba.iterations; },
@@ -358,6 +363,9 @@ std::vector<ConfigKey> make_table() {
     field("loop", "global_ba_merge_after_s", [](auto& o) -> auto& { return o.loop.global_ba_merge_after_s; },
           "deterministic mode: a global BA's result enters the map at the first frame this many seconds "
           "(input time) after the frame that started it; tracking waits there if it is not done"),
+    field("loop", "correction_merge_after_frames", [](auto& o) -> auto& { return o.loop.correction_merge_after_frames; },
+          "deterministic mode: a loop correction's essential graph is solved beside tracking and the rest of "
+          "the map moves before the frame this many frames after the correction began", at_least(1)),
 
     unsigned_field("system", "seed", [](auto& o) -> auto& { return o.seed; },
                    "seed of every random choice (the PnP RANSAC of relocalization and loop closing)", at_least(0)),

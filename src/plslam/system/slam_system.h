@@ -143,12 +143,18 @@ class System {
   // edits the map for the new one and, once the edits are done (wait_for_map_edits(), before the
   // next frame is tracked), optimises its local BA beside tracking. finish_local_ba() joins the
   // job and finishes its keyframe in the caller, at the frame mapping.ba_merge_after_frames fixes.
-  void start_mapping_job(long frame_id);
+  void start_mapping_job(long frame_id, double timestamp);
   void wait_for_map_edits();
   void finish_local_ba();
-  // The last steps of the keyframe whose local BA is in flight: its result and keyframe culling,
-  // then its loop closing (with mapping_job_ joined, or from the next job itself).
-  void finish_mapped_keyframe();
+  // Loop closing in deterministic mode: detection and verification of the keyframes mapping
+  // finished (start_loop_job()) run beside tracking until the next meeting point (join_loop_job(),
+  // or the next job before its edits); what they found is done at the meeting points
+  // (run_loop_closing_steps()): a verified loop's correction begins there, its essential graph is
+  // solved beside tracking, and it ends loop.correction_merge_after_frames later; a global BA a
+  // revisit asked for starts there.
+  void start_loop_job();
+  void join_loop_job();
+  void run_loop_closing_steps(long frame_id);
   // Deterministic mode: fixes the merge frame of a global BA that started, and merges it there.
   void merge_due_global_ba(long frame_id, double timestamp);
   bool deterministic() const;
@@ -174,6 +180,13 @@ class System {
   bool job_edits_done_ = true;  // guarded by job_mutex_
   bool ba_in_flight_ = false;   // mapping_job_ holds a keyframe that finish_local_ba() must finish
   long ba_due_frame_ = -1;      // ... before this frame is tracked
+  double ba_due_time_ = -1;     // ... and before the first frame of this input time (window size)
+  double job_timestamp_ = 0;    // the input time of the frame whose keyframe the job maps
+  std::size_t job_ba_observations_ = 0;  // its BA window's observations; guarded by job_mutex_
+  std::thread loop_job_;        // loop closing's detection and verification, beside tracking
+  long correction_due_frame_ = -1;  // an open loop correction ends before this frame is tracked
+  long steps_due_frame_ = -1;  // loop closing's steps wait for a frame with no local BA in flight, until this one
+  std::optional<std::pair<long, long>> revisit_for_loop_closing_;  // global_ba_after_keyframe's arguments
   long seen_global_ba_starts_ = 0;
   double last_timestamp_ = 0;       // the last frame's input time
   double global_ba_merge_at_ = -1;  // input time of the pending global BA's merge (-1: none)
