@@ -338,6 +338,8 @@ void System::finish() {
   finished_ = true;
   join_loop_job();
   finish_local_ba();
+  // An open correction ends before the keyframes that waited for it are mapped.
+  if (loop_closer_) loop_closer_->finish_deferred_correction();
   mapper_->wait_idle();
   mapper_->stop();
   if (loop_closer_) {
