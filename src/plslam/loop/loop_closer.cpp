@@ -402,12 +402,9 @@ void LoopCloser::process(map::KeyFrame* kf) {
     std::lock_guard lock(stats_mutex_);
     ++stats_.global_ba_after_relocalization;
   }
-  if (options_.defer_loop_correction) {
-    gba_requested_ = true;  // the caller starts it where nothing writes the map
-    return;
-  }
-  abort_global_ba();  // an older one's snapshot predates the revisit
-  start_global_ba();
+  gba_requested_ = true;
+  // Deferred, the caller starts it where nothing writes the map.
+  if (!options_.defer_loop_correction) start_requested_global_ba();
 }
 
 bool LoopCloser::close_loop(map::KeyFrame* kf) {
@@ -535,7 +532,7 @@ void LoopCloser::refresh_queued_connections() {
 void LoopCloser::start_requested_global_ba() {
   if (!gba_requested_) return;
   gba_requested_ = false;
-  abort_global_ba();  // an older one's snapshot predates the revisit
+  abort_global_ba();  // an older one's snapshot predates the revisit or loop that asked for this one
   start_global_ba();
 }
 

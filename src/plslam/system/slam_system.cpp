@@ -99,7 +99,7 @@ System::System(const StereoCalibration& calib, SystemOptions options, std::share
   tracker_ = std::make_unique<tracking::Tracker>(
       map_, options_.tracker, [mapper](map::KeyFrame* kf) { mapper->insert(kf); },
       [this, mapper, sequential] {
-        if (deterministic()) return !ba_in_flight_ && !(loop_closer_ && loop_closer_->correction_open());
+        if (deterministic()) return !ba_in_flight_ && !correction_open();
         return sequential || mapper->idle();
       });
   tracker_->set_mapping_queue([mapper, sequential] { return sequential ? std::size_t{0} : mapper->queued(); });
@@ -133,7 +133,7 @@ FrameResult System::process(const io::StereoFrame& frame) {
     mapping_waits_.add(ms_since(tw));
     merge_due_global_ba(static_cast<long>(frame.index), frame.timestamp);
     start_loop_job();
-    if (!ba_in_flight_ && !loop_job_.joinable() && !(loop_closer_ && loop_closer_->correction_open())) reclaim_culled();
+    if (!ba_in_flight_ && !loop_job_.joinable() && !correction_open()) reclaim_culled();
   }
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
@@ -216,7 +216,7 @@ void System::start_mapping_job(long frame_id, double timestamp) {
   if (mapper_->queued() == 0) return;
   // A local BA on a map half corrected (the query's side moved, the rest not yet) would bend it;
   // the keyframes made meanwhile wait, and move with the map when the correction ends.
-  if (loop_closer_ && loop_closer_->correction_open()) return;
+  if (correction_open()) return;
   std::thread previous = std::move(mapping_job_);
   std::thread examining = std::move(loop_job_);
   const bool finish_previous = ba_in_flight_;
@@ -285,12 +285,17 @@ void System::join_loop_job() {
   if (loop_job_.joinable()) loop_job_.join();
 }
 
+bool System::correction_open() const { return loop_closer_ && loop_closer_->correction_open(); }
+
+void System::tell_loop_closing_of_revisit() {
+  if (!revisit_for_loop_closing_) return;
+  loop_closer_->global_ba_after_keyframe(revisit_for_loop_closing_->first, revisit_for_loop_closing_->second);
+  revisit_for_loop_closing_.reset();
+}
+
 void System::run_loop_closing_steps(long frame_id) {
   if (!loop_closer_) return;
-  if (revisit_for_loop_closing_) {
-    loop_closer_->global_ba_after_keyframe(revisit_for_loop_closing_->first, revisit_for_loop_closing_->second);
-    revisit_for_loop_closing_.reset();
-  }
+  tell_loop_closing_of_revisit();
   const bool end_due = loop_closer_->correction_open() && frame_id >= correction_due_frame_;
   const bool pending = loop_closer_->loop_pending();
   if (!end_due && !pending && !loop_closer_->global_ba_requested()) return;
@@ -343,9 +348,7 @@ void System::finish() {
   mapper_->wait_idle();
   mapper_->stop();
   if (loop_closer_) {
-    if (revisit_for_loop_closing_) {
-      loop_closer_->global_ba_after_keyframe(revisit_for_loop_closing_->first, revisit_for_loop_closing_->second);
-    }
+    tell_loop_closing_of_revisit();
     loop_closer_->finish();
     loop_closer_->stop();
   }
