@@ -70,6 +70,20 @@ TEST(LocalBaWindow, TheOriginStaysFixedInsideTheWindow) {
   EXPECT_EQ(w.points.size(), 80u);
 }
 
+// A BA that covers keyframes mapped before it in one go optimises them too, covisible or not.
+TEST(LocalBaWindow, AlsoFreeKeyframesAreOptimisedWithTheirLandmarks) {
+  Chain c;
+  c.connect();
+  const MapBaProblem w = local_ba_window(*c.kf[3], LocalBaOptions{}, {c.kf[4], c.kf[3]});
+  // 4 (not a covisible of 3) joins free with D, which 0 sees too (fixed: the origin); 3 once.
+  EXPECT_EQ(fixed_flags(w), (std::map<map::KeyFrame*, bool>{{c.kf[0], true},
+                                                            {c.kf[1], false},
+                                                            {c.kf[2], false},
+                                                            {c.kf[3], false},
+                                                            {c.kf[4], false}}));
+  EXPECT_EQ(w.points.size(), 80u);
+}
+
 // Keyframe 3 takes B's first point for C's 10th keypoint, a wrong association, and does not
 // observe C's 10th point.
 void connect_with_a_wrong_association(Chain& c, map::MapPoint** wrong, int* wrong_index) {

@@ -157,6 +157,25 @@ TEST(LocalMapperSequential, TheNextKeyframeFinishesTheDeferredOneFirst) {
   EXPECT_TRUE(mapper.idle());
 }
 
+// Deterministic mode: keyframes that waited together (a loop correction held them) are all mapped
+// in full, and the last one's local BA covers the others, free in its window: none is skipped.
+TEST(LocalMapperSequential, KeyframesWaitingTogetherShareTheLastOnesBaAndNoneIsSkipped) {
+  Row r;
+  LocalMapper mapper(r.m.map, no_culling());
+  mapper.insert(r.kf[2]);
+  mapper.insert(r.kf[3]);
+  mapper.process_pending_deferring_ba();
+  EXPECT_EQ(mapper.deferred_ba_observations(), 4u * 60u);  // 0 is the origin: fixed, but observing
+  mapper.finish_deferred();
+  const auto st = mapper.stats();
+  EXPECT_EQ(st.keyframe_ms.size(), 2u);
+  EXPECT_EQ(st.fusion_ms.size(), 2u);
+  EXPECT_EQ(st.local_ba_ms.size(), 1u);
+  EXPECT_EQ(st.covered_local_ba, 1);
+  EXPECT_EQ(st.skipped_local_ba, 0);
+  EXPECT_LT(r.error2(), 1e-4);
+}
+
 // Reclamation's seam: try_pause() holds an idle mapper only, and the held mapper takes no keyframe.
 TEST(LocalMapperThread, TryPauseHoldsOnlyAnIdleMapper) {
   Row r;

@@ -1,5 +1,6 @@
 #include "plslam/mapping/local_ba_window.h"
 
+#include <algorithm>
 #include <mutex>
 
 #include <spdlog/spdlog.h>
@@ -8,10 +9,14 @@
 
 namespace plslam::mapping {
 
-MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o) {
+MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o,
+                             const std::vector<map::KeyFrame*>& also_free) {
   std::vector<map::KeyFrame*> local{&kf};
   for (auto* n : kf.covisibles()) {
     if (!n->is_bad()) local.push_back(n);
+  }
+  for (auto* k : also_free) {
+    if (k != &kf && !k->is_bad() && std::find(local.begin(), local.end(), k) == local.end()) local.push_back(k);
   }
   MapBaProblem window(o.line_information, o.far_stereo_baselines, o.lines);
   for (auto* k : local) window.add_keyframe(k, k->is_origin());

@@ -3,6 +3,7 @@
 // which keyframes and landmarks it optimises, which keyframes stay fixed, and how the result goes
 // back into the map.
 #include <atomic>
+#include <vector>
 
 #include "plslam/map/map.h"
 #include "plslam/mapping/map_ba_problem.h"
@@ -21,8 +22,10 @@ struct LocalBaOptions {
 
 // The window of `kf`: it and its good covisibles are optimised, except the map's origin, which
 // stays fixed; so are the points (and lines) they see; every other good keyframe that sees those
-// landmarks joins fixed.
-MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o);
+// landmarks joins fixed. `also_free`: keyframes optimised with them, covisible or not (the
+// keyframes mapped before `kf` in one go, whose BA this one is; bad ones are left out).
+MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o,
+                             const std::vector<map::KeyFrame*>& also_free = {});
 
 // Writes a BA result of `window` back into the map: removes the outlier observations, sets the
 // poses of the free keyframes, the positions of good points and the endpoints of good lines (each

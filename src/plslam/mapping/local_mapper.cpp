@@ -112,7 +112,7 @@ void LocalMapper::wait_idle() {
   cv_.wait(lock, [this] { return (queue_.empty() && !busy_) || stop_requested_; });
 }
 
-void LocalMapper::process_front(std::unique_lock<std::mutex>& lock, bool defer) {
+void LocalMapper::process_front(std::unique_lock<std::mutex>& lock, bool defer, bool in_caller) {
   map::KeyFrame* kf = queue_.front();
   queue_.pop_front();
   const bool more = !queue_.empty();
@@ -120,7 +120,7 @@ void LocalMapper::process_front(std::unique_lock<std::mutex>& lock, bool defer) 
   abort_ba_ = false;  // an abort meant for the previous keyframe's BA
   lock.unlock();
   finish_deferred();
-  process(kf, more, defer);
+  process(kf, more, defer, in_caller);
   lock.lock();
   busy_ = false;
   cv_.notify_all();
@@ -129,12 +129,12 @@ void LocalMapper::process_front(std::unique_lock<std::mutex>& lock, bool defer) 
 void LocalMapper::process_pending() {
   finish_deferred();
   std::unique_lock lock(queue_mutex_);
-  while (!queue_.empty()) process_front(lock);
+  while (!queue_.empty()) process_front(lock, false, true);
 }
 
 void LocalMapper::process_pending_deferring_ba() {
   std::unique_lock lock(queue_mutex_);
-  while (!queue_.empty()) process_front(lock, true);
+  while (!queue_.empty()) process_front(lock, true, true);
 }
 
 void LocalMapper::optimise_deferred_ba() {
@@ -189,7 +189,7 @@ void LocalMapper::run() {
   }
 }
 
-void LocalMapper::process(map::KeyFrame* kf, bool more_waiting, bool defer) {
+void LocalMapper::process(map::KeyFrame* kf, bool more_waiting, bool defer, bool in_caller) {
   const auto t0 = Clock::now();
   process_new_keyframe(kf);
   // The bag of words is computed here, off the tracking thread (ORB-SLAM2 does it in local mapping too).
@@ -200,23 +200,38 @@ void LocalMapper::process(map::KeyFrame* kf, bool more_waiting, bool defer) {
   const double triangulation_ms = ms_since(t);
   double fusion_ms = -1;
   const bool ba_due = options_.local_ba && map_.num_keyframes() > 2;
-  bool ba_skipped = ba_due && more_waiting;
+  // In the caller's thread (deterministic mode), a keyframe with more waiting is mapped in full but
+  // its BA is the last one's, with it free in the window; the mapping thread, which must catch
+  // up, skips its fusion and BA (ORB-SLAM2).
+  const bool covered_by_next = in_caller && more_waiting;
+  bool ba_skipped = ba_due && more_waiting && !covered_by_next;
   Deferred d;
   d.kf = kf;
-  d.more_waiting = more_waiting;
+  d.more_waiting = more_waiting && !covered_by_next;
   // Like ORB-SLAM2: the expensive steps only when tracking is not waiting with more keyframes.
-  if (!more_waiting) {
+  if (!more_waiting || covered_by_next) {
     t = Clock::now();
     fuse(kf);
     fusion_ms = ms_since(t);
     // An abort raised before the BA starts (a pause, a newer keyframe) skips it.
     ba_skipped = ba_due && abort_ba_;
-    if (ba_due && !ba_skipped) {
+    if (covered_by_next) {
+      if (ba_due && !ba_skipped) covered_.push_back(kf);
+    } else if (ba_due && !ba_skipped) {
       t = Clock::now();
-      d.window.emplace(local_ba_window(*kf, options_.ba));
+      d.window.emplace(local_ba_window(*kf, options_.ba, covered_));
       d.ba_ms = ms_since(t);
       if (d.window->problem.point_observations.empty()) d.window.reset();
     }
+  }
+  const int covered = d.window ? static_cast<int>(covered_.size()) : 0;
+  if (!covered_by_next) {
+    // Without a window here (an abort, nothing to optimise), the keyframes it was to cover are skipped.
+    const int uncovered = d.window ? 0 : static_cast<int>(covered_.size());
+    std::lock_guard lock(stats_mutex_);
+    stats_.covered_local_ba += covered;
+    stats_.skipped_local_ba += uncovered;
+    covered_.clear();
   }
   d.processing_ms = ms_since(t0);
   {

@@ -68,6 +68,9 @@ struct LocalMapperStats {
   // Keyframes whose local BA never started: more keyframes were waiting (fusion was skipped too),
   // or an abort (a pause for loop closing, a newer keyframe) came first.
   int skipped_local_ba = 0;
+  // Deterministic mode: keyframes mapped in one go with a later one (they waited while a loop
+  // correction was open), whose local BA is that later keyframe's, with them free in its window.
+  int covered_local_ba = 0;
   // The most keyframes ever waiting in the queue (the one being processed not counted), each
   // insert() included: 1 when mapping always kept up. A queue that grows means mapping cannot
   // keep up, and the keyframes waiting skip fusion and local BA (process()).
@@ -119,7 +122,9 @@ class LocalMapper {
 
   // The deterministic mode's pipeline, in three steps that the system calls at frames it fixes.
   // process_pending_deferring_ba() processes the queued keyframes like process_pending(), except
-  // that the last one's local BA is only prepared: its window is built (the map is read here).
+  // that the last one's local BA is only prepared: its window is built (the map is read here), and
+  // it covers the keyframes before it, which are fused and culled as usual but get no BA of their
+  // own (they are free in its window: stats covered_local_ba, not skipped_local_ba).
   // optimise_deferred_ba() runs the solver, which reads only the window, so it may run in another
   // thread beside tracking, which then reads a map that nothing writes. finish_deferred() (a no-op
   // when nothing is deferred) optimises if that has not run, writes the result back, culls
@@ -136,9 +141,10 @@ class LocalMapper {
  private:
   void run();
   // Pops the front keyframe (lock held), processes it with the lock released, marks idle again.
-  void process_front(std::unique_lock<std::mutex>& lock, bool defer = false);
-  // With `defer`, stops before the local BA's solver (process_pending_deferring_ba()).
-  void process(map::KeyFrame* kf, bool more_waiting, bool defer);
+  void process_front(std::unique_lock<std::mutex>& lock, bool defer = false, bool in_caller = false);
+  // With `defer`, stops before the local BA's solver (process_pending_deferring_ba()). `in_caller`:
+  // not the mapping thread (process_pending*), where keyframes waiting together share a BA.
+  void process(map::KeyFrame* kf, bool more_waiting, bool defer, bool in_caller);
   // Adds the keyframe's observations of the landmarks tracking associated, and its covisibility
   // edges; the landmarks it made itself go on probation.
   void process_new_keyframe(map::KeyFrame* kf);
@@ -162,6 +168,8 @@ class LocalMapper {
 
   // Touched only by the mapping thread (or the caller of process_pending()).
   RecentLandmarks recent_;
+  // Deterministic mode: keyframes processed with more waiting, free in the next local BA's window.
+  std::vector<map::KeyFrame*> covered_;
   // A processed keyframe whose last steps wait: its local BA (window empty: none due), its
   // keyframe culling and its hand-over to loop closing.
   struct Deferred {

@@ -125,6 +125,7 @@ nlohmann::json RunReport::to_json(const System& slam) const {
       {"max_queue", ms.max_queue},
       {"local_ba_runs", ms.local_ba_ms.size()},
       {"local_ba_skipped", ms.skipped_local_ba},
+      {"local_ba_covered", ms.covered_local_ba},
       {"keyframes_refused_queue_full", slam.tracker().keyframes_refused_queue_full()}};
   // Deterministic mode: where tracking waited for the other threads (timings, like the ms above).
   auto waits = [](const WaitStats& w) {
