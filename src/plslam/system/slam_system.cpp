@@ -119,12 +119,14 @@ FrameResult System::process(const io::StereoFrame& frame) {
   r.timestamp = frame.timestamp;
   // The id is the frame's place in the input, so skipped frames leave gaps instead of shifting
   // every later frame (the keyframe policy counts frames by id, the outputs align by it).
+  if (deterministic()) finish_due_local_ba_beside_extraction(static_cast<long>(frame.index), frame.timestamp);
   auto data = extractor_.extract(static_cast<long>(frame.index), frame.timestamp, frame.left, frame.right, &r.extraction);
   if (deterministic()) {
     // The meeting point: the map as the frames before left it, whatever the timing: the last
     // keyframe's edits, and the local BAs whose frame has come.
     const auto tw = std::chrono::steady_clock::now();
     wait_for_map_edits();
+    if (!ba_in_flight_ && mapping_job_.joinable()) mapping_job_.join();  // a BA finished beside extraction
     join_loop_job();
     if (ba_in_flight_ && static_cast<long>(frame.index) >= ba_due_frame_ && frame.timestamp >= ba_due_time_) {
       finish_local_ba();
@@ -270,6 +272,22 @@ void System::finish_local_ba() {
   ba_in_flight_ = false;
   join_loop_job();  // it reads what the result changes
   mapper_->finish_deferred();
+}
+
+void System::finish_due_local_ba_beside_extraction(long frame_id, double timestamp) {
+  // Due here, and its due time is known (wait_for_map_edits() fixed it): nothing reads the map
+  // until the meeting point but loop closing's examination, which the job joins first; so the
+  // map's operations are the meeting point's, in the same order, only sooner.
+  if (!ba_in_flight_ || ba_due_time_ < 0 || frame_id < ba_due_frame_ || timestamp < ba_due_time_) return;
+  std::thread job = std::move(mapping_job_);
+  std::thread examining = std::move(loop_job_);
+  ba_in_flight_ = false;
+  mapping_job_ = std::thread([this, job = std::move(job), examining = std::move(examining)]() mutable {
+    core::name_this_thread("plslam-mapping");
+    if (job.joinable()) job.join();
+    if (examining.joinable()) examining.join();  // it reads what the result changes
+    mapper_->finish_deferred();
+  });
 }
 
 void System::start_loop_job() {

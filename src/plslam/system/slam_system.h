@@ -146,6 +146,10 @@ class System {
   void start_mapping_job(long frame_id, double timestamp);
   void wait_for_map_edits();
   void finish_local_ba();
+  // The local BA due at this frame is finished in mapping_job_ while the frame's features are
+  // extracted (its result, keyframe culling, the hand-over to loop closing: 3 ms of tracking's
+  // time on the street loop); the meeting point joins it. Not at lag 1 (its due time is unknown).
+  void finish_due_local_ba_beside_extraction(long frame_id, double timestamp);
   // Loop closing in deterministic mode: detection and verification of the keyframes mapping
   // finished (start_loop_job()) run beside tracking until the next meeting point (join_loop_job(),
   // or the next job before its edits); what they found is done at the meeting points
