@@ -169,9 +169,9 @@ TEST(RunDeterministic, KittiRunsAreIdenticalToEachOtherAndWithAOneFrameLagToSequ
 
 // The street loop (synth's KITTI preset, 300 frames, seed 2: the street loop 300) with
 // --deterministic: its loop is corrected in three steps beside tracking and its global BA is merged
-// at a frame fixed in input time (here: at the run's end), so two runs give the same bytes, global BA included. Release
-// only (2 x 300 KITTI-size frames); the threads it runs are watched under ThreadSanitizer by
-// RunDeterministic on KITTI 06 and LoopClosingConcurrent.
+// at a frame fixed in input time (here: at the run's end), so two runs give the same bytes, global
+// BA included. Release only (2 x 300 KITTI-size frames); the threads it runs are watched under
+// ThreadSanitizer by RunDeterministic on KITTI 06 and LoopClosingConcurrent.
 TEST(StreetLoopRun, DeterministicRunsWithTheirGlobalBaAreIdentical) {
   test::TempDir tmp;
   const auto seq = tmp.path() / "street";

@@ -200,23 +200,22 @@ void LocalMapper::process(map::KeyFrame* kf, bool more_waiting, bool defer, bool
   const double triangulation_ms = ms_since(t);
   double fusion_ms = -1;
   const bool ba_due = options_.local_ba && map_.num_keyframes() > 2;
-  // In the caller's thread (deterministic mode), a keyframe with more waiting is mapped in full but
-  // its BA is the last one's, with it free in the window; the mapping thread, which must catch
-  // up, skips its fusion and BA (ORB-SLAM2).
-  const bool covered_by_next = in_caller && more_waiting;
-  bool ba_skipped = ba_due && more_waiting && !covered_by_next;
+  // The mapping thread, which must catch up, skips a keyframe's fusion and BA while more wait
+  // (ORB-SLAM2). In the caller's thread (deterministic mode) it is mapped in full, and its BA is
+  // the last waiting keyframe's, with it free in that window.
+  const bool catching_up = more_waiting && !in_caller;
+  bool ba_skipped = ba_due && catching_up;
   Deferred d;
   d.kf = kf;
-  d.more_waiting = more_waiting && !covered_by_next;
-  // Like ORB-SLAM2: the expensive steps only when tracking is not waiting with more keyframes.
-  if (!more_waiting || covered_by_next) {
+  d.more_waiting = catching_up;
+  if (!catching_up) {
     t = Clock::now();
     fuse(kf);
     fusion_ms = ms_since(t);
     // An abort raised before the BA starts (a pause, a newer keyframe) skips it.
     ba_skipped = ba_due && abort_ba_;
-    if (covered_by_next) {
-      if (ba_due && !ba_skipped) covered_.push_back(kf);
+    if (ba_due && !ba_skipped && more_waiting) {
+      covered_.push_back(kf);
     } else if (ba_due && !ba_skipped) {
       t = Clock::now();
       d.window.emplace(local_ba_window(*kf, options_.ba, covered_));
@@ -224,19 +223,19 @@ void LocalMapper::process(map::KeyFrame* kf, bool more_waiting, bool defer, bool
       if (d.window->problem.point_observations.empty()) d.window.reset();
     }
   }
-  const int covered = d.window ? static_cast<int>(covered_.size()) : 0;
-  if (!covered_by_next) {
-    // Without a window here (an abort, nothing to optimise), the keyframes it was to cover are skipped.
-    const int uncovered = d.window ? 0 : static_cast<int>(covered_.size());
-    std::lock_guard lock(stats_mutex_);
-    stats_.covered_local_ba += covered;
-    stats_.skipped_local_ba += uncovered;
+  // The last of the waiting keyframes: its window covers the ones before it, or (an abort,
+  // nothing to optimise) they go without a BA.
+  int covered = 0;
+  int uncovered = 0;
+  if (!more_waiting) {
+    (d.window ? covered : uncovered) = static_cast<int>(covered_.size());
     covered_.clear();
   }
   d.processing_ms = ms_since(t0);
   {
     std::lock_guard lock(stats_mutex_);
-    stats_.skipped_local_ba += ba_skipped;
+    stats_.skipped_local_ba += ba_skipped + uncovered;
+    stats_.covered_local_ba += covered;
     stats_.triangulation_ms.push_back(triangulation_ms);
     if (fusion_ms >= 0) stats_.fusion_ms.push_back(fusion_ms);
   }

@@ -128,9 +128,7 @@ FrameResult System::process(const io::StereoFrame& frame) {
     wait_for_map_edits();
     if (!ba_in_flight_ && mapping_job_.joinable()) mapping_job_.join();  // a BA finished beside extraction
     join_loop_job();
-    if (ba_in_flight_ && static_cast<long>(frame.index) >= ba_due_frame_ && frame.timestamp >= ba_due_time_) {
-      finish_local_ba();
-    }
+    if (local_ba_due(static_cast<long>(frame.index), frame.timestamp)) finish_local_ba();
     run_loop_closing_steps(static_cast<long>(frame.index));
     mapping_waits_.add(ms_since(tw));
     merge_due_global_ba(static_cast<long>(frame.index), frame.timestamp);
@@ -274,11 +272,15 @@ void System::finish_local_ba() {
   mapper_->finish_deferred();
 }
 
+bool System::local_ba_due(long frame_id, double timestamp) const {
+  return ba_in_flight_ && frame_id >= ba_due_frame_ && timestamp >= ba_due_time_;
+}
+
 void System::finish_due_local_ba_beside_extraction(long frame_id, double timestamp) {
   // Due here, and its due time is known (wait_for_map_edits() fixed it): nothing reads the map
   // until the meeting point but loop closing's examination, which the job joins first; so the
   // map's operations are the meeting point's, in the same order, only sooner.
-  if (!ba_in_flight_ || ba_due_time_ < 0 || frame_id < ba_due_frame_ || timestamp < ba_due_time_) return;
+  if (ba_due_time_ < 0 || !local_ba_due(frame_id, timestamp)) return;
   std::thread job = std::move(mapping_job_);
   std::thread examining = std::move(loop_job_);
   ba_in_flight_ = false;

@@ -146,6 +146,8 @@ class System {
   void start_mapping_job(long frame_id, double timestamp);
   void wait_for_map_edits();
   void finish_local_ba();
+  // The local BA in flight is due at this frame (its frame and input time have come).
+  bool local_ba_due(long frame_id, double timestamp) const;
   // The local BA due at this frame is finished in mapping_job_ while the frame's features are
   // extracted (its result, keyframe culling, the hand-over to loop closing: 3 ms of tracking's
   // time on the street loop); the meeting point joins it. Not at lag 1 (its due time is unknown).
