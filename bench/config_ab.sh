@@ -5,7 +5,7 @@
 #
 # Each preset gets SECTION.KEY set to each value (replaced, or added under the section's header).
 # Every sequence then runs N times per value, the values alternating run by run, in the default
-# concurrent mode with loop closing: KITTI 06 and 01 (kitti preset), the rendered street loop (300
+# mode (deterministic: its runs are identical, N=1 suffices) with loop closing: KITTI 06 and 01 (kitti preset), the rendered street loop (300
 # frames, kitti preset), the rendered office loop (480 frames) and the corridor loop (742 frames;
 # both euroc preset). Renders already in OUT/street, OUT/office and OUT/corridor (or symlinks
 # there) are reused. OUT/summary.txt has each run's median tracking ms, ATE, keyframes and median

@@ -8,7 +8,7 @@
 # worse without it); the exactly rectified street render loses scale with it, since most of its
 # points are far. This runs the KITTI preset with each value on KITTI 06 and 01 (frames 0-50) and on
 # the rendered street loop of 300 and 600 frames, with and without loop closing, in the default
-# concurrent mode: N runs per cell, the values alternating run by run. OUT/summary.txt has each
+# mode (deterministic since issue 50; the numbers in the docs are the free-running mode's): N runs per cell, the values alternating run by run. OUT/summary.txt has each
 # run's ATE and, per cell, the median, min and max. docs/analysis/far_stereo.md has the numbers.
 set -euo pipefail
 cd "$(dirname "$0")/.."

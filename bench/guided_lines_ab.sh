@@ -6,7 +6,7 @@
 # lines.guided_stereo (on in both presets) finds each left line's right-image partner by a search
 # along its rows; off, the right image gets its own line detection and LBD, matched as in the
 # paper. This is bench/config_ab.sh with that key true and false: both alternate run by run, in the
-# default concurrent mode with loop closing, on KITTI 06 and 01 (frames 0-50), the rendered street
+# default (deterministic) mode with loop closing, on KITTI 06 and 01 (frames 0-50), the rendered street
 # loop (300 frames, KITTI preset), the rendered office loop (480 frames) and the corridor loop (742
 # frames; both EuRoC preset). OUT/summary.txt has each run's median tracking ms, ATE, keyframes and
 # median stereo points and lines per frame, and per cell the medians and the ratio of tracking time

@@ -9,7 +9,7 @@
 #   - the keyframe policy's velocity_min_frames set to 1 and 3 on KITTI (which frames become
 #     keyframes, with every frame still there);
 #   - on the office loop, loop closing off (odometry), as in bench/odometry_analysis.sh.
-# A dropped frame (bench/drop_frame_sweep.sh) and a concurrent run (thread scheduling) change the
+# A dropped frame (bench/drop_frame_sweep.sh) and a free-running run (thread scheduling) change the
 # same things: the feature sets and which frames become keyframes. OUT/summary.txt holds the ATE of
 # each run and the median, min, max and max/min per group.
 set -euo pipefail

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A long run (issue 19): a rendered street loop driven again and again, N frames (default 6000:
-# 10 minutes at 10 Hz, 12 laps of the 241 m loop at 5 m/s), run in the default concurrent mode.
+# 10 minutes at 10 Hz, 12 laps of the 241 m loop at 5 m/s), run in the default (deterministic) mode.
 #
 #   bench/long_run.sh [--frames N] OUT
 #

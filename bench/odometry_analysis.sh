@@ -2,12 +2,11 @@
 # Odometry analysis on rendered office loops (issue 22): where the error grows and why.
 #
 #   bench/odometry_analysis.sh [--seeds "1 2 3"] [--runs N] [--anchor PATH] [--config FILE]
-#                              [--deterministic] OUT
+#                              [--free-running] OUT
 #
 # For each seed: renders `synth --scene office --preset euroc --frames 480 --loop --seed S`, runs
-# plslam once with --sequential (reproducible) and N times in the default concurrent mode (with
-# --deterministic: once with --deterministic, whose runs are identical; the anchor still runs N
-# times), all
+# plslam once with --sequential (reproducible) and once in the default mode, whose runs are
+# identical (with --free-running: N times with --free-running; the anchor runs N times either way), all
 # with --no-loop-closing (this measures the odometry: a closed loop would hide its drift), and,
 # with --anchor (e.g. ../shared/anchors/orbslam3/run), the anchor with --no-loop-closing,
 # alternating run by run with plslam. Every plslam run gets `plslam eval --plot --frames`:
@@ -16,14 +15,15 @@
 # run and the median, min and max ATE per seed and system.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seeds="1 2 3" runs=5 anchor="" config="" mode=concurrent
+seeds="1 2 3" runs=5 anchor="" config="" mode=deterministic
 while [ $# -gt 1 ]; do
   case "$1" in
     --seeds) seeds=$2; shift 2 ;;
     --runs) runs=$2; shift 2 ;;
     --anchor) anchor=$2; shift 2 ;;
     --config) config="--config $2"; shift 2 ;;
-    --deterministic) mode=deterministic; shift ;;
+    --deterministic) mode=deterministic; shift ;;  # the default
+    --free-running) mode=free-running; shift ;;
     *) echo "odometry_analysis.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -59,10 +59,10 @@ for seed in $seeds; do
     if [ "$mode" = deterministic ]; then
       [ "$i" -eq 1 ] || continue  # identical runs: one is the measurement
       run_dir="$out/seed$seed-deterministic"
-      "$plslam" run "$seq" --deterministic --no-loop-closing --quiet $config --out "$run_dir" >/dev/null
-    else
-      run_dir="$out/seed$seed-concurrent-$i"
       "$plslam" run "$seq" --no-loop-closing --quiet $config --out "$run_dir" >/dev/null
+    else
+      run_dir="$out/seed$seed-free-running-$i"
+      "$plslam" run "$seq" --free-running --no-loop-closing --quiet $config --out "$run_dir" >/dev/null
     fi
     "$plslam" eval --gt "$seq/mav0/synth/left_camera.tum" --est "$run_dir/trajectory.tum" --plot "$run_dir/plots" \
       --frames "$run_dir/frames.csv" >/dev/null 2>&1

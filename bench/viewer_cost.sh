@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # What the live viewer costs tracking (issue 17): the same sequence run N times each way,
-# alternating, in the default concurrent mode, and the median of each run's median tracking ms.
+# alternating, in the default (deterministic) mode, and the median of each run's median tracking ms.
 #
 #   bench/viewer_cost.sh [--runs N] [--dataset DIR] [--modes "off browser ..."] OUT
 #

@@ -33,16 +33,18 @@ done
 # ThreadSanitizer runs the tests whose code under test starts threads of plslam's own: the worker
 # pool and the BA that uses it, the local mapper's thread with its pause and abort
 # (LocalMapperThread), the map snapshot taken beside a writer (MapSnapshotConcurrent), the stereo extraction tasks, the image prefetch thread, synth's
-# parallel rendering, `plslam run` in the default concurrent mode (tracking + local mapping +
-# prefetch), and the robustness suites that run a threaded command (the image prefetch of
+# parallel rendering, `plslam run` in the default mode (RunDeterministic: the mapping and loop
+# jobs beside tracking, two runs compared byte for byte) and with --free-running (RunConcurrent:
+# tracking + local mapping thread + prefetch), and the robustness suites that run a threaded command (the image prefetch of
 # `plslam run`, synth and bench stopped by a signal), the keyframe database (local mapping adds,
-# tracking queries), a concurrent run that relocalizes (RelocalizationConcurrent), and loop closing
-# (LoopClosingConcurrent: its thread and global BA on a map, and `plslam run` with all threads), the
+# tracking queries), a default run that relocalizes (RelocalizationConcurrent), and loop closing
+# (LoopClosingConcurrent: its thread and global BA on a map, and two default runs of `plslam run`
+# with all threads, compared byte for byte), the
 # browser viewer's server threads and its publisher beside a run (ViewerServer, LiveViewerRun); the suites on reading user input (InputRobustness,
 # JsonStdoutRobustness, ConfigRobustness) test parsing and checks, not threads, and run in the
 # other two stages. The sequential end-to-end accuracy runs
 # are left to the other stages: in them local mapping runs in the tracking thread, and
-# RunConcurrent covers every seam between the threads.
+# RunDeterministic, RunConcurrent and LoopClosingConcurrent cover every seam between the threads.
 TSAN_SUITES='WorkerPool|LocalMapperThread|MapSnapshotConcurrent|BundleAdjustment|StereoPoints|FrameStream|LiveCapture|VideoDataset|SynthFormats|SynthDeterminism|RunConcurrent|RunDeterministic|TimeRobustness|SignalRobustness|KeyframeDatabase|RelocalizationConcurrent|LoopClosingConcurrent|ViewerServer|LiveViewerRun'
 TSAN_TESTS="^(${TSAN_SUITES})\\."
 # The test executables that hold them (tests/<folder> -> test_<folder>), plus the CLI they run: the

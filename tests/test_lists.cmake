@@ -16,12 +16,13 @@
 # LABELS tsan_skip: left out by the ThreadSanitizer stage only; asan_skip: by the AddressSanitizer one only.
 # (The CI run of 2026-11-26 took 56.7 of its 60 minutes; that of 2026-11-29 65.)
 
-plslam_test(LoopClosingConcurrent.RenderedOfficeLoopClosesAtTheRevisitOnly COST 90)
+# One default run of the office loop under ASan (90 s); under ThreadSanitizer the identity test's
+# two runs of it.
+plslam_test(LoopClosingConcurrent.RenderedOfficeLoopClosesAtTheRevisitOnly COST 90 LABELS tsan_skip)
 plslam_test(RunSignals.StopAtAFrameBoundaryAndWriteEverything COST 60)
-# 4 concurrent runs compared as a spread (57 s under ASan, where thread timing widens it); the
-# bench's runs and report run there in the SIGTERM test.
-plslam_test(BenchSlamCli.ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAnchorIsARow COST 57
-  LABELS sanitizer_skip)
+# 4 default runs compared byte for byte (57 s under ASan); the bench's runs and report run there in
+# the SIGTERM test.
+plslam_test(BenchSlamCli.DefaultRunsEqualASeparateRunAndAnAnchorIsARow COST 57 LABELS sanitizer_skip)
 plslam_test(RelocalizationConcurrent.KidnappedKittiCameraIsFoundAgainWhileLocalMappingRuns COST 55)
 plslam_test(LiveViewerRun.AClientFollowsTheMapAsItGrowsAndEndsOnTheFinalState COST 50)
 plslam_test(Relocalization.WithoutPlaceRecognitionALostCameraStartsANewSegment COST 45)
@@ -35,22 +36,22 @@ plslam_test(PublicApi.TracksASequenceWithPosesTheTrajectoryAndMapAgreeOn COST 33
 plslam_test(RunDeterminism.RepeatReportsTheSpreadOfSequentialRuns COST 31)
 plslam_test(PublicApi.SavedMapIsLoadedAndLocalizedIn COST 30)
 plslam_test(RunConcurrent.Kitti06WithLocalMappingThread COST 30)
-# Under ThreadSanitizer, LoopClosingConcurrent.RenderedOfficeLoopClosesAtTheRevisitOnly runs the
-# same threads on the same scene, with loop closing and its global BA on top (109 s of the stage).
+# Free-running (--free-running). Under ThreadSanitizer, RunConcurrent KITTI 06 and micro watch the
+# free-running mapping thread, and LoopClosingConcurrent the same scene in the default mode.
 plslam_test(RunConcurrent.SyntheticOfficeWithLocalMappingThread COST 28 LABELS tsan_skip)
-# Each runs plslam twice to compare the bytes: the same code as RunEndToEnd; with loop closing,
+# Runs plslam twice to compare the bytes: the same code as RunEndToEnd; with loop closing,
 # whose loop runs under the sanitizers in LoopClosingConcurrent.
 plslam_test(LoopRun.SequentialRunsWithALoopAreIdentical COST 27 LABELS sanitizer_skip)
-# Two --deterministic runs of the same loop (the deferred global BA's merge); the pipeline's threads
-# run under the sanitizers in RunDeterministic.
-plslam_test(LoopRun.DeterministicRunsWithALoopAreIdentical COST 27 LABELS sanitizer_skip)
+# Two default runs of the same loop (the deferred global BA's merge), compared byte for byte, also
+# under ThreadSanitizer; under ASan the one run of RenderedOfficeLoopClosesAtTheRevisitOnly.
+plslam_test(LoopClosingConcurrent.DefaultRunsWithALoopAreIdentical COST 120 LABELS asan_skip)
 # For ThreadSanitizer's eyes (the mapping job beside extraction); under ASan (62 s) it would add
 # only what RunDeterminism's sequential runs, also left out there, cover.
 plslam_suite(RunDeterministic COST 6 LABELS asan_skip)
-# Two --deterministic runs of the street loop 300 with its global BA (38 s alone, 61 s in the Release
+# Two default runs of the street loop 300 with its global BA (38 s alone, 61 s in the Release
 # stage of 2026-11-29); its threads run under the sanitizers in RunDeterministic and
 # LoopClosingConcurrent.
-plslam_test(StreetLoopRun.DeterministicRunsWithTheirGlobalBaAreIdentical COST 60 LABELS sanitizer_skip)
+plslam_test(StreetLoopRun.DefaultRunsWithTheirGlobalBaAreIdentical COST 60 LABELS sanitizer_skip)
 plslam_test(RunDeterminism.SequentialKittiRunsAreByteIdentical COST 6 LABELS sanitizer_skip)
 plslam_test(RunDeterminism.SequentialRenderedRunsAreByteIdentical COST 10 LABELS sanitizer_skip)
 plslam_test(RunConcurrent.EurocMicroWithLocalMappingThread COST 25)

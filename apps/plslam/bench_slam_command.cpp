@@ -48,9 +48,13 @@ void add_bench_slam_options(CLI::App& sub, BenchSlamArgs& a) {
   sub.add_option("--jobs", a.jobs, "Runs at a time (only 1: parallel runs would distort every timing)")
       ->check(CLI::Range(1, 1))->capture_default_str();
   auto* sequential =
-      sub.add_flag("--sequential", a.sequential, "plslam runs with --sequential (reproducible; anchors unaffected)");
-  sub.add_flag("--deterministic", a.deterministic, "plslam runs with --deterministic (anchors unaffected)")
-      ->excludes(sequential);
+      sub.add_flag("--sequential", a.sequential, "plslam runs with --sequential (anchors unaffected)");
+  auto* deterministic =
+      sub.add_flag("--deterministic", a.deterministic, "plslam runs in its default deterministic mode (the default)");
+  sub.add_flag("--free-running", a.free_running, "plslam runs with --free-running (anchors unaffected)")
+      ->excludes(sequential)
+      ->excludes(deterministic);
+  deterministic->excludes(sequential);
   sub.add_option("--table1-frames", a.table1_frames, "Frames per dataset for Table I (keypoint distribution); 0: skip")
       ->check(CLI::Range(0, 100000))->capture_default_str();
   sub.add_flag("--json", a.json, "Print report.json on stdout (logs stay on stderr)");
@@ -133,7 +137,7 @@ std::vector<std::string> job_argv(const bench::BenchRow& row, const fs::path& da
   std::vector<std::string> argv = {current_executable().string(), "run", dataset.string(), "--out", folder.string(),
                                    "--quiet", "--config", (out / "configs" / (row.name + ".yaml")).string()};
   if (a.sequential) argv.push_back("--sequential");
-  if (a.deterministic) argv.push_back("--deterministic");
+  if (a.free_running) argv.push_back("--free-running");
   return argv;
 }
 
@@ -150,6 +154,7 @@ std::string command_line(const BenchSlamArgs& a) {
   if (!a.shared.empty()) c += " --shared " + arg(a.shared);
   if (a.sequential) c += " --sequential";
   if (a.deterministic) c += " --deterministic";
+  if (a.free_running) c += " --free-running";
   if (a.table1_frames != 20) c += fmt::format(" --table1-frames {}", a.table1_frames);
   return c + " --out " + arg(a.out);
 }
@@ -266,7 +271,7 @@ int run_bench_slam(const BenchSlamArgs& a) {
   report["date"] = now_utc();
   report["hardware_threads"] = std::thread::hardware_concurrency();
   report["runs"] = a.runs;
-  report["mode"] = a.sequential ? "sequential" : a.deterministic ? "deterministic" : "concurrent";
+  report["mode"] = a.sequential ? "sequential" : a.free_running ? "free-running" : "deterministic";
   report["preset"] = a.preset.empty() ? json(nullptr) : json(a.preset);
   report["anchor"] = a.anchor.empty() ? json(nullptr) : json(a.anchor);
   report["configurations"] = json::array();

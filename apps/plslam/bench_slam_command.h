@@ -18,7 +18,8 @@ struct BenchSlamArgs {
   std::string shared;  // ../shared for --preset paper
   int jobs = 1;
   bool sequential = false;
-  bool deterministic = false;
+  bool deterministic = false;  // the default; the flag is kept so that older command lines still run
+  bool free_running = false;
   int table1_frames = 20;
   bool json = false;
 };

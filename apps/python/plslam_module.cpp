@@ -177,9 +177,10 @@ PYBIND11_MODULE(plslam, m) {
            }),
            py::arg("calibration"), py::kw_only(), py::arg("config") = py::none(), py::arg("preset") = "euroc",
            py::arg("lines") = true, py::arg("place_recognition") = true, py::arg("loop_closing") = true,
-           py::arg("sequential") = false, py::arg("deterministic") = false, py::arg("localization_only") = false,
+           py::arg("sequential") = false, py::arg("deterministic") = true, py::arg("localization_only") = false,
            py::arg("vocabulary") = py::none(),
-           "calibration: a StereoCalibration or the path of a calibration file")
+           "calibration: a StereoCalibration or the path of a calibration file; deterministic=False: the "
+           "free-running pipeline (runs differ); sequential=True: mapping in the tracking thread")
       .def(
           "track",
           [](Slam& s, const ImageArray& left, const ImageArray& right, double t) {

@@ -49,12 +49,13 @@ struct SlamOptions {
   bool place_recognition = true;      // relocalization after loss (needs the vocabulary)
   bool loop_closing = true;           // needs place recognition
   // Local mapping and loop closing run inside track() instead of their own threads: slower, and
-  // the poses are the same from run to run.
+  // the poses are the same from run to run (the debugging mode).
   bool sequential = false;
-  // Local mapping and loop closing on their own thread, met before the next frame is tracked
-  // (README "How the threads meet"): the same poses from run to run, as sequential's up to the
-  // first global BA. Ignored with sequential.
-  bool deterministic = false;
+  // The default: local mapping and loop closing on their own threads, met at frames fixed in
+  // advance (README "How the threads meet"), so the poses are the same from run to run. false: the
+  // free-running pipeline, whose threads meet whenever they are done (results differ from run to
+  // run, and local mapping skips BAs when it falls behind). Ignored with sequential.
+  bool deterministic = true;
   // With load_map(): track in the loaded map without adding keyframes, points or lines.
   bool localization_only = false;
 };

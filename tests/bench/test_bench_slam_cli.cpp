@@ -105,7 +105,7 @@ TEST(BenchSlamCli, QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequen
   }
 }
 
-TEST(BenchSlamCli, ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAnchorIsARow) {
+TEST(BenchSlamCli, DefaultRunsEqualASeparateRunAndAnAnchorIsARow) {
   test::TempDir dir;
   const auto dataset = render_office(dir.path(), 40);
   // A stand-in anchor with the runner's interface: the ground truth with a 1 cm wobble.
@@ -131,18 +131,15 @@ TEST(BenchSlamCli, ConcurrentRunsAgreeWithASeparateRunWithinTheirSpreadAndAnAnch
   EXPECT_EQ(s["anchor"]["keyframes"]["median"], 7);
   EXPECT_TRUE(s["full"]["ratio_to_anchor"]["ate_m"].is_number());
   EXPECT_FALSE(s.contains("anchor-no-loop-closing"));
-  const double lo = s["full"]["ate_m"]["min"].get<double>(), hi = s["full"]["ate_m"]["max"].get<double>();
-  const double med = s["full"]["ate_m"]["median"].get<double>();
-
-  const auto sep = dir.path() / "separate-concurrent";
-  const auto rr = run_cli("run " + q(dataset) + " --quiet --out " + q(sep));
+  // The default mode is deterministic: the bench's runs and a separate run agree to the byte.
+  EXPECT_EQ(s["full"]["ate_m"]["min"], s["full"]["ate_m"]["max"]);
+  const auto sep = dir.path() / "separate";
+  const auto rr = run_cli("run " + q(dataset) + " --quiet --config " + q(out / "configs" / "full.yaml") + " --out " +
+                          q(sep));
   ASSERT_EQ(rr.exit_code, 0) << rr.err;
-  const double ate = eval_ate(dataset, sep / "trajectory.tum");
-  // Within the bench's spread, widened by the larger of 3 spreads and half the median (three runs
-  // under-sample the spread of concurrent runs, and sanitizer builds shift the thread timing).
-  const double slack = std::max(3.0 * (hi - lo), 0.5 * med);
-  EXPECT_GE(ate, lo - slack) << "bench " << lo << "-" << hi << ", separate " << ate;
-  EXPECT_LE(ate, hi + slack) << "bench " << lo << "-" << hi << ", separate " << ate;
+  EXPECT_EQ(test::read_file(sep / "trajectory.tum"),
+            test::read_file(out / "runs" / "office" / "full" / "run-2" / "trajectory.tum"));
+  EXPECT_EQ(eval_ate(dataset, sep / "trajectory.tum"), s["full"]["ate_m"]["median"].get<double>());
 }
 
 TEST(BenchSlamCli, SigtermStopsAtARunBoundaryAndTheReportCoversTheRunsDone) {

@@ -1,7 +1,9 @@
-// End-to-end in the default concurrent mode: tracking, the local-mapping thread and the image
-// prefetch thread all run at once. The other end-to-end tests use --sequential for reproducible
-// bounds; these are the runs the ThreadSanitizer stage of CI watches, so they must exercise every
-// seam between the threads (keyframe queue, map locks, landmark descriptors, BA write-back).
+// End-to-end in the free-running mode (--free-running, the default before the deterministic
+// pipeline): tracking, the local-mapping thread and the image prefetch thread all run at once and
+// meet whenever they are done. The other end-to-end tests use --sequential or the default for
+// reproducible bounds; these are the free-running runs the ThreadSanitizer stage of CI watches, so
+// they must exercise every seam between the threads (keyframe queue, map locks, landmark
+// descriptors, BA write-back).
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -15,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 nlohmann::json run_concurrent(const fs::path& seq, const fs::path& out, const std::string& extra = "") {
-  const auto r = test::run_cli("run \"" + seq.string() + "\" --out \"" + out.string() + "\" --quiet" + extra);
+  const auto r = test::run_cli("run \"" + seq.string() + "\" --out \"" + out.string() + "\" --quiet --free-running" + extra);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(out / "stats.json");
   if (r.exit_code != 0 || !in) return {};

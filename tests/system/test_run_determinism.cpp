@@ -132,9 +132,10 @@ TEST(RunDeterminism, SequentialRenderedRunsAreByteIdentical) {
   expect_identical_sequential_runs(seq, "");
 }
 
-// --deterministic: local mapping and loop closing on their own thread, met at frames fixed in
-// advance: a keyframe's map edits before the next frame is tracked, its local BA (which optimises
-// beside tracking) two frames after it. Two runs are identical. With the BA met before the next
+// The default mode (--deterministic): local mapping and loop closing on their own thread, met at
+// frames fixed in advance: a keyframe's map edits before the next frame is tracked, its local BA
+// (which optimises beside tracking) two frames after it. Two runs are identical, with and without
+// the flag. With the BA met before the next
 // frame (mapping.ba_merge_after_frames 1, and not later for a large window:
 // ba_merge_ms_per_1000_observations 0) and no loop (none here), the map evolves
 // as --sequential's and the outputs are identical to its. The ThreadSanitizer stage runs it.
@@ -144,11 +145,11 @@ TEST(RunDeterministic, KittiRunsAreIdenticalToEachOtherAndWithAOneFrameLagToSequ
   const auto seq = data / "kitti/sequences/06";
   const std::string extra = " --max-frames 20";
   const auto a = run_mode(seq, tmp.path() / "a", "--deterministic", extra);
-  const auto b = run_mode(seq, tmp.path() / "b", "--deterministic", extra);
+  const auto b = run_mode(seq, tmp.path() / "b", "", extra);  // the default
   ASSERT_FALSE(a.is_null());
   EXPECT_EQ(a["mode"], "deterministic");
   EXPECT_EQ(a, b);
-  expect_same_outputs(tmp.path() / "a", tmp.path() / "b", "two --deterministic runs");
+  expect_same_outputs(tmp.path() / "a", tmp.path() / "b", "a --deterministic and a default run");
   EXPECT_GT(a["keyframes"].get<int>(), 3);
   // Every keyframe gets its local BA (the first two have no window yet).
   EXPECT_EQ(a["local_mapping"]["local_ba_skipped"], 0);
@@ -165,21 +166,26 @@ TEST(RunDeterministic, KittiRunsAreIdenticalToEachOtherAndWithAOneFrameLagToSequ
   const auto r = test::run_cli("run \"" + seq.string() + "\" --deterministic --sequential --out \"" +
                                (tmp.path() / "bad").string() + "\"");
   EXPECT_EQ(r.exit_code, 2) << "the two modes exclude each other";
+  for (const char* modes : {"--free-running --sequential", "--free-running --deterministic"}) {
+    const auto rr = test::run_cli("run \"" + seq.string() + "\" " + modes + " --out \"" +
+                                  (tmp.path() / "bad").string() + "\"");
+    EXPECT_EQ(rr.exit_code, 2) << modes;
+  }
 }
 
-// The street loop (synth's KITTI preset, 300 frames, seed 2: the issue's street loop 300) with
-// --deterministic: its loop is corrected in three steps beside tracking and its global BA is merged
+// The street loop (synth's KITTI preset, 300 frames, seed 2: the issue's street loop 300) in the
+// default mode: its loop is corrected in three steps beside tracking and its global BA is merged
 // at a frame fixed in input time (here: at the run's end), so two runs give the same bytes, global
 // BA included. Release only (2 x 300 KITTI-size frames); the threads it runs are watched under
 // ThreadSanitizer by RunDeterministic on KITTI 06 and LoopClosingConcurrent.
-TEST(StreetLoopRun, DeterministicRunsWithTheirGlobalBaAreIdentical) {
+TEST(StreetLoopRun, DefaultRunsWithTheirGlobalBaAreIdentical) {
   test::TempDir tmp;
   const auto seq = tmp.path() / "street";
   const auto synth = test::run_cli("synth --out \"" + seq.string() +
                                    "\" --scene street --preset kitti --format kitti --frames 300 --loop --seed 2");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
-  auto a = run_mode(seq, tmp.path() / "a", "--deterministic", "");
-  auto b = run_mode(seq, tmp.path() / "b", "--deterministic", "");
+  auto a = run_mode(seq, tmp.path() / "a", "", "");
+  auto b = run_mode(seq, tmp.path() / "b", "", "");
   ASSERT_FALSE(a.is_null());
   ASSERT_FALSE(b.is_null());
   ASSERT_GE(a["loops"].size(), 1u) << a.dump();

@@ -155,7 +155,7 @@ nlohmann::json RunReport::to_json(const System& slam) const {
   return {{"complete", complete},
           {"mode", slam.options().sequential       ? "sequential"
                    : slam.options().deterministic ? "deterministic"
-                                                  : "concurrent"},
+                                                  : "free-running"},
           {"seed", slam.options().seed},
           {"input_frames", input_frames},
           {"frames", frames},

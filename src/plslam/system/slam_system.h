@@ -30,12 +30,14 @@ struct SystemOptions {
   tracking::TrackerOptions tracker;
   mapping::LocalMapperOptions mapper;
   bool sequential = false;
-  // The deterministic pipeline (ignored with `sequential`): local mapping and loop closing work on
+  // The deterministic pipeline, the default (ignored with `sequential`; false: the free-running
+  // pipeline, whose threads meet whenever they are done): local mapping and loop closing work on
   // their own thread while the next frame's features are extracted, and tracking waits for them
   // before it reads the map; the global BA optimises beside both and is merged at a frame fixed in
-  // advance (loop.global_ba_merge_after_s). Runs are identical to --sequential's up to the first
-  // global BA, and identical to each other; see the README ("How the threads meet").
-  bool deterministic = false;
+  // advance (loop.global_ba_merge_after_s). Runs are identical to each other, and with a one-frame
+  // lag (mapping.ba_merge_after_frames 1, ba_merge_ms_per_1000_observations 0) to --sequential's
+  // up to the first loop; see the README ("How the threads meet").
+  bool deterministic = true;
   // Seed of every random choice (config `system.seed`, recorded in stats.json): the PnP RANSAC
   // of relocalization (geometry::PnpOptions::seed). Tracking, mapping and BA make none.
   std::uint32_t seed = 1;
