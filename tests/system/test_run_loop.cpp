@@ -3,8 +3,9 @@
 // that the sanitizer stages of CI can afford it), with 15 % of the loop travelled again after the
 // return: the revisit lasts ~25 frames. With synth's default 3 % it lasted 5, and a concurrent run
 // slowed by a sanitizer, with fewer keyframes, could end before the loop was confirmed. The
-// default (deterministic) runs are the ones the sanitizer stages watch: tracking, local mapping,
-// loop detection, the essential graph, the global BA and the image prefetch all at once.
+// sanitizer stages watch these runs: tracking, local mapping, loop detection, the essential
+// graph, the global BA and the image prefetch all at once (ThreadSanitizer the default mode's,
+// AddressSanitizer a --free-running one).
 #include <fstream>
 #include <memory>
 
@@ -70,13 +71,15 @@ std::unique_ptr<test::TempDir> LoopRun::tmp_;
 
 using LoopClosingConcurrent = LoopRun;
 
-// One default run, for the AddressSanitizer stage (the identity test below runs two).
+// One --free-running run, for the AddressSanitizer stage: the loop-closing thread as it runs
+// there. A default run takes 202 s under ASan (every local BA waited for) against 90; the default
+// mode's loop runs under ThreadSanitizer and in Release in the identity test below, and its
+// correction steps under ASan in LoopCorrection.InThreeSteps*.
 TEST_F(LoopClosingConcurrent, RenderedOfficeLoopClosesAtTheRevisitOnly) {
   test::TempDir out;
-  const auto stats = run(out.path() / "run");
+  const auto stats = run(out.path() / "run", " --free-running");
   expect_true_loops(stats);
-  EXPECT_EQ(stats["mode"], "deterministic");
-  EXPECT_EQ(stats["local_mapping"]["local_ba_skipped"], 0);
+  EXPECT_EQ(stats["mode"], "free-running");
 }
 
 TEST_F(LoopRun, SequentialRunsWithALoopAreIdentical) {
