@@ -47,14 +47,9 @@ void add_bench_slam_options(CLI::App& sub, BenchSlamArgs& a) {
   sub.add_option("--shared", a.shared, "The shared folder for --preset paper (default: $PLSLAM_SHARED_DIR, else ../shared)");
   sub.add_option("--jobs", a.jobs, "Runs at a time (only 1: parallel runs would distort every timing)")
       ->check(CLI::Range(1, 1))->capture_default_str();
-  auto* sequential =
-      sub.add_flag("--sequential", a.sequential, "plslam runs with --sequential (anchors unaffected)");
-  auto* deterministic =
-      sub.add_flag("--deterministic", a.deterministic, "plslam runs in its default deterministic mode (the default)");
-  sub.add_flag("--free-running", a.free_running, "plslam runs with --free-running (anchors unaffected)")
-      ->excludes(sequential)
-      ->excludes(deterministic);
-  deterministic->excludes(sequential);
+  add_mode_flags(sub, a.mode, "plslam runs with --sequential (anchors unaffected)",
+                 "plslam runs in its default deterministic mode (the default)",
+                 "plslam runs with --free-running (anchors unaffected)");
   sub.add_option("--table1-frames", a.table1_frames, "Frames per dataset for Table I (keypoint distribution); 0: skip")
       ->check(CLI::Range(0, 100000))->capture_default_str();
   sub.add_flag("--json", a.json, "Print report.json on stdout (logs stay on stderr)");
@@ -136,8 +131,7 @@ std::vector<std::string> job_argv(const bench::BenchRow& row, const fs::path& da
   }
   std::vector<std::string> argv = {current_executable().string(), "run", dataset.string(), "--out", folder.string(),
                                    "--quiet", "--config", (out / "configs" / (row.name + ".yaml")).string()};
-  if (a.sequential) argv.push_back("--sequential");
-  if (a.free_running) argv.push_back("--free-running");
+  if (!a.mode.run_flag().empty()) argv.push_back(a.mode.run_flag());
   return argv;
 }
 
@@ -152,9 +146,9 @@ std::string command_line(const BenchSlamArgs& a) {
   if (!a.config_file.empty()) c += " --config-file " + arg(a.config_file);
   if (!a.anchor.empty()) c += " --anchor " + arg(a.anchor);
   if (!a.shared.empty()) c += " --shared " + arg(a.shared);
-  if (a.sequential) c += " --sequential";
-  if (a.deterministic) c += " --deterministic";
-  if (a.free_running) c += " --free-running";
+  if (a.mode.sequential) c += " --sequential";
+  if (a.mode.deterministic) c += " --deterministic";
+  if (a.mode.free_running) c += " --free-running";
   if (a.table1_frames != 20) c += fmt::format(" --table1-frames {}", a.table1_frames);
   return c + " --out " + arg(a.out);
 }
@@ -271,7 +265,7 @@ int run_bench_slam(const BenchSlamArgs& a) {
   report["date"] = now_utc();
   report["hardware_threads"] = std::thread::hardware_concurrency();
   report["runs"] = a.runs;
-  report["mode"] = a.sequential ? "sequential" : a.free_running ? "free-running" : "deterministic";
+  report["mode"] = a.mode.name();
   report["preset"] = a.preset.empty() ? json(nullptr) : json(a.preset);
   report["anchor"] = a.anchor.empty() ? json(nullptr) : json(a.anchor);
   report["configurations"] = json::array();

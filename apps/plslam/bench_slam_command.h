@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "commands/mode_options.h"
+
 namespace plslam::cli {
 
 struct BenchSlamArgs {
@@ -17,9 +19,7 @@ struct BenchSlamArgs {
   std::string preset;  // "", quick or paper
   std::string shared;  // ../shared for --preset paper
   int jobs = 1;
-  bool sequential = false;
-  bool deterministic = false;  // the default; the flag is kept so that older command lines still run
-  bool free_running = false;
+  ModeArgs mode;
   int table1_frames = 20;
   bool json = false;
 };

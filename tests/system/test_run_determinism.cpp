@@ -135,10 +135,9 @@ TEST(RunDeterminism, SequentialRenderedRunsAreByteIdentical) {
 // The default mode (--deterministic): local mapping and loop closing on their own thread, met at
 // frames fixed in advance: a keyframe's map edits before the next frame is tracked, its local BA
 // (which optimises beside tracking) two frames after it. Two runs are identical, with and without
-// the flag. With the BA met before the next
-// frame (mapping.ba_merge_after_frames 1, and not later for a large window:
-// ba_merge_ms_per_1000_observations 0) and no loop (none here), the map evolves
-// as --sequential's and the outputs are identical to its. The ThreadSanitizer stage runs it.
+// the flag. With the BA met before the next frame (mapping.ba_merge_after_frames 1, and not later
+// for a large window: ba_merge_ms_per_1000_observations 0) and no loop (none here), the map
+// evolves as --sequential's and the outputs are identical to its. The ThreadSanitizer stage runs it.
 TEST(RunDeterministic, KittiRunsAreIdenticalToEachOtherAndWithAOneFrameLagToSequential) {
   PLSLAM_REQUIRE_SHARED_DATA(data);
   test::TempDir tmp;

@@ -14,6 +14,7 @@
 #include "command_registry.h"
 #include "stop_signals.h"
 #include "commands/dataset_options.h"
+#include "commands/mode_options.h"
 #include "plslam/core/error.h"
 #include "plslam/core/stopwatch.h"
 #include "plslam/core/version.h"
@@ -62,9 +63,7 @@ struct RunArgs {
   bool no_lines = false;
   bool quiet = false;
   bool realtime = false;
-  bool sequential = false;
-  bool deterministic = false;  // the default; the flag is kept so that older command lines still run
-  bool free_running = false;
+  ModeArgs mode;
   int repeat = 1;
   std::string save_map;  // --save-map FILE
   std::string load_map;  // --load-map FILE
@@ -128,8 +127,8 @@ std::string map_config_text(const RunArgs& args, io::DatasetFormat preset) {
                       {"config_file", args.config},
                       {"no_lines", args.no_lines},
                       {"no_loop_closing", args.no_loop_closing},
-                      {"sequential", args.sequential},
-                      {"deterministic", !args.sequential && !args.free_running},
+                      {"sequential", args.mode.sequential},
+                      {"deterministic", !args.mode.sequential && !args.mode.free_running},
                       {"loaded_map", args.load_map}};
   if (!args.config.empty()) {
     std::ifstream in(args.config);
@@ -167,8 +166,8 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   auto options = system::load_system_options(
       preset, args.config.empty() ? std::nullopt : std::optional<fs::path>(args.config));
   if (args.no_lines) options.disable_lines();
-  options.sequential = args.sequential;
-  options.deterministic = !args.free_running;
+  options.sequential = args.mode.sequential;
+  options.deterministic = !args.mode.free_running;
   if (!args.vocabulary.empty()) options.vocabulary = args.vocabulary;
   if (args.no_place_recognition) options.place_recognition = false;
   if (args.no_loop_closing) options.loop_closing = false;
@@ -565,19 +564,13 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                            sub.add_flag("--quiet", args->quiet, "No progress lines");
                            sub.add_flag("--realtime", args->realtime, "Pace the input at the dataset's frame rate")
                                ->excludes(camera);
-                           auto* sequential = sub.add_flag(
-                               "--sequential", args->sequential,
-                               "Run local mapping and loop closing in the tracking thread (the debugging mode)");
-                           auto* deterministic = sub.add_flag(
-                               "--deterministic", args->deterministic,
+                           add_mode_flags(
+                               sub, args->mode,
+                               "Run local mapping and loop closing in the tracking thread (the debugging mode)",
                                "The default: the threads meet at frames fixed in advance, so runs are identical "
-                               "to each other (local mapping beside the next frame's extraction)");
-                           sub.add_flag("--free-running", args->free_running,
-                                        "The threads meet whenever they are done: runs differ, and local mapping "
-                                        "skips BAs when it falls behind (the pipeline before the deterministic one)")
-                               ->excludes(sequential)
-                               ->excludes(deterministic);
-                           deterministic->excludes(sequential);
+                               "to each other (local mapping beside the next frame's extraction)",
+                               "The threads meet whenever they are done: runs differ, and local mapping skips BAs "
+                               "when it falls behind (the pipeline before the deterministic one)");
                            sub.add_option("--save-map", args->save_map,
                                           "Save the map at the end (after loop closing) to FILE (.plmap)");
                            auto* load = sub.add_option("--load-map", args->load_map,
