@@ -172,4 +172,14 @@ Matrix6d se3_left_jacobian_inverse(const Vector6d& xi) {
 
 Matrix6d se3_right_jacobian_inverse(const Vector6d& xi) { return se3_left_jacobian_inverse(-xi); }
 
+PoseParams to_pose_params(const SE3& T) {
+  const Eigen::Quaterniond q = T.quaternion();
+  const Eigen::Vector3d& t = T.translation();
+  return {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+}
+
+SE3 from_pose_params(const double* p) {
+  return SE3(Eigen::Quaterniond(p[6], p[3], p[4], p[5]), Eigen::Vector3d(p[0], p[1], p[2]));
+}
+
 }  // namespace plslam::geometry

@@ -2,6 +2,8 @@
 // SO(3)/SE(3) on Eigen. Tangent vectors of SE(3) are ordered xi = [rho; phi] (translation part
 // first, rotation second), and all optimisers perturb poses on the LEFT: T <- exp(delta) * T.
 // Every function is safe near zero rotation (Taylor branches) and near pi (quaternion-based log).
+#include <array>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -56,6 +58,12 @@ class SE3 {
   Eigen::Matrix3d R_;
   Eigen::Vector3d t_;
 };
+
+// A pose as the 7 doubles of a Ceres pose block, [t_x t_y t_z q_x q_y q_z q_w] (optim/'s T_cw
+// blocks, inertial/'s T_wb blocks).
+using PoseParams = std::array<double, 7>;
+PoseParams to_pose_params(const SE3& T);
+SE3 from_pose_params(const double* p);
 
 // SE(3) Jacobians (Barfoot's convention, xi = [rho; phi]):
 // exp(xi + d) ~= exp(J_l(xi) d) exp(xi) ~= exp(xi) exp(J_r(xi) d), with J_r(xi) = J_l(-xi).

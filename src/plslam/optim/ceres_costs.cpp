@@ -9,16 +9,6 @@ namespace plslam::optim {
 
 using geometry::SE3;
 
-PoseParams to_params(const SE3& T) {
-  const Eigen::Quaterniond q = T.quaternion();
-  const Eigen::Vector3d& t = T.translation();
-  return {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
-}
-
-SE3 from_params(const double* p) {
-  return SE3(Eigen::Quaterniond(p[6], p[3], p[4], p[5]), Eigen::Vector3d(p[0], p[1], p[2]));
-}
-
 bool SE3LeftManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
   const geometry::Vector6d d = Eigen::Map<const geometry::Vector6d>(delta);
   const PoseParams out = to_params(SE3::exp(d) * from_params(x));

@@ -15,9 +15,9 @@
 
 namespace plslam::optim {
 
-using PoseParams = std::array<double, 7>;
-PoseParams to_params(const geometry::SE3& T);
-geometry::SE3 from_params(const double* p);
+using PoseParams = geometry::PoseParams;
+inline PoseParams to_params(const geometry::SE3& T) { return geometry::to_pose_params(T); }
+inline geometry::SE3 from_params(const double* p) { return geometry::from_pose_params(p); }
 
 class SE3LeftManifold final : public ceres::Manifold {
  public:

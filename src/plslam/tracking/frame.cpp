@@ -1,5 +1,8 @@
 #include "plslam/tracking/frame.h"
 
+#include "plslam/map/map_line.h"
+#include "plslam/map/map_point.h"
+
 namespace plslam::tracking {
 
 // Culled landmarks do not count: whether reclamation has cleared them from the frame yet depends on
