@@ -15,6 +15,7 @@
 #include "fuzz/targets/fuzz_euroc_sensor.cpp"
 #include "fuzz/targets/fuzz_frame_log.cpp"
 #include "fuzz/targets/fuzz_image.cpp"
+#include "fuzz/targets/fuzz_imu.cpp"
 #include "fuzz/targets/fuzz_map_file.cpp"
 #include "fuzz/targets/fuzz_trajectory.cpp"
 #include "fuzz/targets/fuzz_run_folder.cpp"
@@ -46,6 +47,8 @@ const Target kTargets[] = {
     {"bench_configs", fuzz_bench_configs},
     {"calibration_file", fuzz_calibration_file},
     {"run_folder", fuzz_run_folder},
+    {"imu_csv", fuzz_imu_csv},
+    {"imu_sensor", fuzz_imu_sensor},
 };
 
 class FuzzReplay : public testing::TestWithParam<Target> {};

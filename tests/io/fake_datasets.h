@@ -85,4 +85,42 @@ inline std::filesystem::path make_euroc(const std::filesystem::path& root, int f
   return root;
 }
 
+// An IMU sensor.yaml in EuRoC's imu0 layout (its ADIS16448 noise values), the IMU `tx` metres
+// along the body's x axis.
+inline std::string imu_sensor_yaml(double tx = 0.0) {
+  return "%YAML:1.0\n"
+         "sensor_type: imu\n"
+         "T_BS:\n  cols: 4\n  rows: 4\n"
+         "  data: [1.0, 0.0, 0.0, " + std::to_string(tx) + ",\n"
+         "         0.0, 1.0, 0.0, 0.0,\n"
+         "         0.0, 0.0, 1.0, 0.0,\n"
+         "         0.0, 0.0, 0.0, 1.0]\n"
+         "rate_hz: 200\n"
+         "gyroscope_noise_density: 1.6968e-04\n"
+         "gyroscope_random_walk: 1.9393e-05\n"
+         "accelerometer_noise_density: 2.0000e-3\n"
+         "accelerometer_random_walk: 3.0000e-3\n";
+}
+
+// IMU samples in EuRoC's imu0/data.csv layout from `first_ns` to `last_ns` (inclusive) every
+// `period_ns`: gyro (0.01, 0.02, 0.03) rad/s, acc (0.1, 0.2, 9.81) m/s^2.
+inline std::string imu_csv(long long first_ns, long long last_ns, long long period_ns = 5'000'000) {
+  std::string s = "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
+                  "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
+  for (long long ns = first_ns; ns <= last_ns; ns += period_ns) {
+    s += std::to_string(ns) + ",0.01,0.02,0.03,0.1,0.2,9.81\n";
+  }
+  return s;
+}
+
+// mav0/imu0 for make_euroc's frames (the first at 1403715273000000000 ns, 50 ms apart), 200 Hz
+// from `before_s` seconds before the first frame to `after_s` after the last.
+inline void add_euroc_imu(const std::filesystem::path& root, int frames = 3, double before_s = 1.0,
+                          double after_s = 1.0) {
+  const long long first = 1403715273000000000LL, last = first + 50000000LL * (frames - 1);
+  write_file(root / "mav0" / "imu0" / "data.csv",
+             imu_csv(first - static_cast<long long>(before_s * 1e9), last + static_cast<long long>(after_s * 1e9)));
+  write_file(root / "mav0" / "imu0" / "sensor.yaml", imu_sensor_yaml(0.05));
+}
+
 }  // namespace plslam::test

@@ -326,6 +326,7 @@ TEST(RealData, Kitti06Info) {
   EXPECT_NEAR(j["baseline_m"].get<double>(), 0.537, 0.0005);
   EXPECT_TRUE(j["has_ground_truth"].get<bool>());
   EXPECT_NEAR(j["gt_path_length_m"].get<double>(), 60.0, 1.0);
+  EXPECT_TRUE(j["imu"].is_null()) << j["imu"];  // KITTI has no IMU
 }
 
 TEST(RealData, Kitti01InfoWarnsAbout10Hz) {
@@ -350,6 +351,9 @@ TEST(RealData, EurocMicroInfo) {
   EXPECT_NEAR(j["fps"].get<double>(), 20.0, 0.01);
   EXPECT_NEAR(j["baseline_m"].get<double>(), 0.110, 0.001);
   EXPECT_TRUE(j["has_ground_truth"].get<bool>());
+  // imu0 at 200 Hz, kept from the first frame (where it starts) to 0.5 s after the last.
+  EXPECT_EQ(j["imu"]["samples"], 1041) << j["imu"];
+  EXPECT_EQ(j["imu"]["rate_hz_nominal"], 200.0);
 }
 
 // RMS distance of the checkerboard's inner corners to the straight lines through each of its rows

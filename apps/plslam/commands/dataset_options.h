@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "plslam/core/error.h"
 #include "plslam/io/dataset.h"
 
 namespace plslam::cli {
@@ -15,12 +16,16 @@ struct DatasetArgs {
   // Signed, so that "-5" is refused by the range check instead of wrapping around.
   long long start = 0;
   long long max_frames = -1;
+  std::string imu;        // --imu FILE (add_imu_options)
+  std::string imu_calib;  // --imu-calib FILE
 
   io::DatasetOptions options() const {
     io::DatasetOptions o;
     o.format = io::parse_dataset_format(format);
     o.start = static_cast<std::size_t>(start);
     if (max_frames >= 0) o.max_frames = static_cast<std::size_t>(max_frames);
+    o.imu_csv = imu;
+    o.imu_calib = imu_calib;
     return o;
   }
 };
@@ -44,6 +49,30 @@ inline void add_dataset_options(CLI::App& sub, DatasetArgs& args,
   sub.add_option(max_frames_names, args.max_frames, "Use at most this many frames (-1: all)")
       ->check(CLI::Range(-1LL, kMaxFrameArg))
       ->capture_default_str();
+}
+
+// --imu and --imu-calib, for the commands that take video or camera input (a dataset folder
+// brings its own IMU, or none).
+inline void add_imu_options(CLI::App& sub, DatasetArgs& args) {
+  sub.add_option("--imu", args.imu,
+                 "IMU samples for --video or --camera, in EuRoC's imu0/data.csv layout (ns, gyro xyz rad/s, acc xyz "
+                 "m/s^2), needs --imu-calib. Timestamps in ns on the frames' clock: 0 at the video's first frame, "
+                 "frame i at i / fps (--camera: the same for a video file; a V4L2 device's clock starts when plslam "
+                 "opens it)");
+  sub.add_option("--imu-calib", args.imu_calib,
+                 "The IMU's sensor.yaml (EuRoC's imu0 layout: T_BS, rate_hz, noise densities and random walks), for "
+                 "--imu; its body frame is the rectified left camera (T_BS: the IMU's pose in it)");
+}
+
+// Usage errors (exit 2): --imu and --imu-calib go together, and not with a dataset folder.
+inline void check_imu_args(const DatasetArgs& args) {
+  if (args.imu.empty() != args.imu_calib.empty()) {
+    throw InputError("", args.imu.empty() ? "--imu-calib needs --imu FILE" : "--imu needs --imu-calib FILE");
+  }
+  if (!args.imu.empty() && !args.path.empty()) {
+    throw InputError(args.path, "--imu is for --video and --camera input: an EuRoC folder's IMU is its mav0/imu0, "
+                                "and KITTI has none");
+  }
 }
 
 }  // namespace plslam::cli

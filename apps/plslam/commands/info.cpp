@@ -1,5 +1,6 @@
-// plslam info <dataset>: what the readers see — format, size, rate, rectified calibration, and
-// ground truth.
+// plslam info <dataset> | --video FILE --calib FILE: what the readers see — format, size, rate,
+// rectified calibration, ground truth, and the IMU.
+#include <cmath>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -8,17 +9,85 @@
 #include "command_registry.h"
 #include "json_stdout.h"
 #include "commands/dataset_options.h"
+#include "plslam/core/error.h"
+#include "plslam/io/imu_input.h"
+#include "plslam/io/video_dataset.h"
 
 namespace plslam::cli {
 namespace {
 
 struct InfoArgs {
   DatasetArgs dataset;
+  std::string video;  // --video FILE
+  std::string calib;  // --calib FILE, for --video
   bool json = false;
 };
 
+void check_input(const InfoArgs& a) {
+  if (a.dataset.path.empty() == a.video.empty()) {
+    throw InputError("", a.video.empty() ? "no input: give a dataset folder or --video FILE"
+                                         : "give one input only: a dataset folder or --video FILE");
+  }
+  if (!a.video.empty() && a.calib.empty()) throw InputError("", "--video needs --calib FILE");
+  if (a.video.empty() && !a.calib.empty()) {
+    throw InputError("", "--calib is for --video (a dataset folder has its own calibration)");
+  }
+  if (!a.video.empty() && a.dataset.format != "auto") throw InputError("", "--format is for dataset folders");
+  check_imu_args(a.dataset);
+}
+
+double rotation_deg(const Eigen::Isometry3d& T) { return Eigen::AngleAxisd(T.rotation()).angle() * 180.0 / M_PI; }
+
+nlohmann::json imu_json(const io::Dataset& ds) {
+  if (!ds.imu()) return nullptr;
+  const auto& imu = *ds.imu();
+  const auto& s = imu.samples;
+  const auto& n = imu.calibration.noise;
+  nlohmann::json T = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) {
+    T.push_back({imu.T_imu_cam.matrix()(r, 0), imu.T_imu_cam.matrix()(r, 1), imu.T_imu_cam.matrix()(r, 2),
+                 imu.T_imu_cam.matrix()(r, 3)});
+  }
+  return {{"path", ds.imu_path().string()},
+          {"samples", s.size()},
+          {"rate_hz_nominal", imu.calibration.rate_hz},
+          {"rate_hz_measured", io::median_rate_hz(s)},
+          {"t_first_s", s.front().t},
+          {"t_last_s", s.back().t},
+          {"frames_t_first_s", ds.timestamps().front()},
+          {"frames_t_last_s", ds.timestamps().back()},
+          {"T_imu_cam", T},
+          {"rotation_deg", rotation_deg(imu.T_imu_cam)},
+          {"translation_m", imu.T_imu_cam.translation().norm()},
+          {"noise",
+           {{"gyroscope_noise_density", n.gyro_noise_density},
+            {"gyroscope_random_walk", n.gyro_random_walk},
+            {"accelerometer_noise_density", n.acc_noise_density},
+            {"accelerometer_random_walk", n.acc_random_walk}}}};
+}
+
+std::string imu_text(const io::Dataset& ds) {
+  if (!ds.imu()) return "imu          none\n";
+  const auto& imu = *ds.imu();
+  const auto& s = imu.samples;
+  const auto& n = imu.calibration.noise;
+  const double t0 = ds.timestamps().front();
+  const Eigen::Vector3d p = imu.T_imu_cam.translation();
+  return fmt::format("imu          {} samples, {:.2f} Hz nominal, {:.2f} Hz measured (median)  ({})\n", s.size(),
+                     imu.calibration.rate_hz, io::median_rate_hz(s), ds.imu_path().string()) +
+         fmt::format("imu span     {:+.3f} s to {:+.3f} s from the first frame (frames to {:+.3f} s)\n",
+                     s.front().t - t0, s.back().t - t0, ds.timestamps().back() - t0) +
+         fmt::format("imu to cam   T_imu_cam: rotation {:.3f} deg, translation ({:.4f}, {:.4f}, {:.4f}) m, {:.4f} m\n",
+                     rotation_deg(imu.T_imu_cam), p.x(), p.y(), p.z(), p.norm()) +
+         fmt::format("imu noise    gyro {:.4e} rad/s/sqrt(Hz), walk {:.4e} rad/s^2/sqrt(Hz); "
+                     "acc {:.4e} m/s^2/sqrt(Hz), walk {:.4e} m/s^3/sqrt(Hz)\n",
+                     n.gyro_noise_density, n.gyro_random_walk, n.acc_noise_density, n.acc_random_walk);
+}
+
 int run_info(const InfoArgs& args) {
-  const auto ds = io::open_dataset(args.dataset.path, args.dataset.options());
+  check_input(args);
+  const auto ds = args.video.empty() ? io::open_dataset(args.dataset.path, args.dataset.options())
+                                     : io::open_video_dataset(args.video, args.calib, args.dataset.options());
   const auto& c = ds->calibration();
   const auto& t = ds->timestamps();
   const double duration = t.back() - t.front();
@@ -35,7 +104,8 @@ int run_info(const InfoArgs& args) {
                         {"baseline_m", c.baseline},
                         {"duration_s", duration},
                         {"has_ground_truth", ds->ground_truth().has_value()},
-                        {"gt_path_length_m", ds->ground_truth_length()}};
+                        {"gt_path_length_m", ds->ground_truth_length()},
+                        {"imu", imu_json(*ds)}};
     print_json(j.dump(2) + "\n");
     return 0;
   }
@@ -53,13 +123,18 @@ int run_info(const InfoArgs& args) {
   } else {
     std::cout << "ground truth none\n";
   }
+  std::cout << imu_text(*ds);
   return 0;
 }
 
-CommandRegistration reg({"info", "Describe a stereo dataset (format, frames, calibration, ground truth)",
+CommandRegistration reg({"info", "Describe a stereo dataset (format, frames, calibration, ground truth, IMU)",
                          [](CLI::App& sub) {
                            auto args = std::make_shared<InfoArgs>();
-                           add_dataset_options(sub, args->dataset);
+                           add_dataset_options(sub, args->dataset, "--max-frames", false);
+                           sub.add_option("--video", args->video,
+                                          "Side-by-side stereo video instead of a dataset folder (as plslam run)");
+                           sub.add_option("--calib", args->calib, "Stereo calibration file, for --video");
+                           add_imu_options(sub, args->dataset);
                            sub.add_flag("--json", args->json, "Print a JSON object");
                            return std::function<int()>([args] { return run_info(*args); });
                          }});

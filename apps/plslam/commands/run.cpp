@@ -23,6 +23,7 @@
 #include "plslam/io/camera_source.h"
 #include "plslam/io/frame_stream.h"
 #include "plslam/io/image_loading.h"
+#include "plslam/io/imu_input.h"
 #include "plslam/io/live_capture.h"
 #include "plslam/io/map_export.h"
 #include "plslam/io/output_folder.h"
@@ -87,6 +88,8 @@ struct RunInput {
   StereoCalibration calibration;
   io::DatasetFormat format = io::DatasetFormat::kEuroc;
   std::string name;  // the folder, video file or device, for messages
+  // A live camera's --imu (a dataset holds its own, Dataset::imu()). Read and checked, not used yet.
+  std::optional<ImuData> camera_imu;
 };
 
 // Exactly one input, and the options that belong to it (usage errors, exit 2).
@@ -102,12 +105,18 @@ void check_input_args(const RunArgs& a) {
   }
   if (a.dataset.path.empty() && a.dataset.format != "auto") throw InputError("", "--format is for dataset folders");
   if (!a.camera.empty() && a.dataset.start != 0) throw InputError("", "--start is not for a live camera");
+  check_imu_args(a.dataset);
 }
 
 RunInput open_input(const RunArgs& args) {
   RunInput in;
   if (!args.camera.empty()) {
     in.calibration = io::read_calibration_file(args.calib);
+    if (!args.dataset.imu.empty()) {
+      // The camera's frames are the body frame; how long the camera runs is not known ahead, so
+      // the samples are not cut to its frames.
+      in.camera_imu = io::read_imu(args.dataset.imu, args.dataset.imu_calib, Eigen::Isometry3d::Identity());
+    }
     in.camera = io::open_stereo_camera(args.camera, args.camera_right, in.calibration);
     in.name = in.camera->name();
     return in;
@@ -549,6 +558,7 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                            sub.add_option("--calib", args->calib,
                                           "Stereo calibration of the rectified images, for --video and --camera "
                                           "(YAML: width height fx fy cx cy baseline)");
+                           add_imu_options(sub, args->dataset);
                            sub.add_option("--preset", args->preset,
                                           "Configuration preset (default: kitti for KITTI datasets, else euroc)")
                                ->check(CLI::IsMember({"euroc", "kitti"}));

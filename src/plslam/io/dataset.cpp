@@ -76,6 +76,10 @@ fs::path single_kitti_sequence(const fs::path& root) {
 
 std::unique_ptr<Dataset> open_dataset(const fs::path& given, const DatasetOptions& options) {
   std::error_code ec;
+  if (!options.imu_csv.empty() || !options.imu_calib.empty()) {
+    throw InputError(given.string(), "--imu and --imu-calib are for video and camera input: an EuRoC folder's IMU "
+                                     "is its mav0/imu0, and KITTI has none");
+  }
   if (!fs::exists(given, ec)) throw InputError(given.string(), "no such folder");
   if (!fs::is_directory(given, ec)) throw InputError(given.string(), "not a folder");
   // "mav0/" and "sequences/06/" name the same folders as without the slash.

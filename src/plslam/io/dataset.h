@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "plslam/core/error.h"
+#include "plslam/core/imu.h"
 #include "plslam/core/types.h"
 
 namespace plslam::io {
@@ -44,6 +45,9 @@ struct DatasetOptions {
   DatasetFormat format = DatasetFormat::kAuto;
   std::size_t start = 0;                       // first frame to use
   std::optional<std::size_t> max_frames;       // at most this many frames
+  // An IMU for a video (--imu, --imu-calib; see open_video_dataset), both or neither. A dataset
+  // folder has its own (EuRoC's mav0/imu0) or none (KITTI): open_dataset refuses these.
+  std::filesystem::path imu_csv, imu_calib;
 };
 
 class Dataset {
@@ -69,6 +73,12 @@ class Dataset {
   // datasets and published tables do: T_w_rect = T_w_sensor * R_rect_sensor^T.
   const Eigen::Matrix3d& rectification_rotation() const { return R_rect_sensor_; }
 
+  // The input's IMU on the frames' clock, its samples cut to the selected frames plus
+  // kImuMarginS (io/imu_input.h) on each side; nullopt without one (KITTI, an EuRoC sequence
+  // without mav0/imu0, a video without --imu). imu_path() is its sample file.
+  const std::optional<ImuData>& imu() const { return imu_; }
+  const std::filesystem::path& imu_path() const { return imu_path_; }
+
   // Loads and rectifies frame i (0-based within the selected range). A missing or corrupt image
   // throws InputError naming the file.
   virtual StereoFrame load(std::size_t i) const = 0;
@@ -80,6 +90,8 @@ class Dataset {
   std::optional<Trajectory> gt_;
   std::filesystem::path gt_path_;
   Eigen::Matrix3d R_rect_sensor_ = Eigen::Matrix3d::Identity();
+  std::optional<ImuData> imu_;
+  std::filesystem::path imu_path_;
 };
 
 // InputError(file, ...) unless the calibration holds finite intrinsics, positive focal lengths and

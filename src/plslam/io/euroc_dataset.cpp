@@ -17,6 +17,7 @@
 #include "plslam/io/dataset_impl.h"
 #include "plslam/io/euroc_sensor.h"
 #include "plslam/io/image_loading.h"
+#include "plslam/io/imu_input.h"
 #include "plslam/io/text_table.h"
 #include "plslam/io/trajectory_io.h"
 
@@ -91,6 +92,7 @@ class EurocDataset final : public Dataset {
     for (const auto& p : pairs_) timestamps_.push_back(static_cast<double>(p.ns) * 1e-9);
 
     load_ground_truth();
+    load_imu();
     // Fail early on a corrupt first pair or a size that contradicts sensor.yaml.
     (void)load(0);
   }
@@ -189,6 +191,21 @@ class EurocDataset final : public Dataset {
     }
     gt_ = std::move(gt);
     gt_path_ = path;
+  }
+
+  // mav0/imu0 when it is there: a sequence without it has no IMU, one with a broken file is refused.
+  void load_imu() {
+    const auto dir = root_ / "imu0";
+    std::error_code ec;
+    if (!fs::exists(dir, ec)) return;
+    if (!fs::is_directory(dir, ec)) throw InputError(dir.string(), "is a file, expected the IMU's folder");
+    // The rectified left camera in the body frame: cam0's T_BS after undoing the rectification's
+    // rotation (p_raw = R_rect_sensor^T * p_rect).
+    Eigen::Isometry3d T_sensor_rect = Eigen::Isometry3d::Identity();
+    T_sensor_rect.linear() = R_rect_sensor_.transpose();
+    imu_path_ = dir / "data.csv";
+    imu_ = read_imu(imu_path_, dir / "sensor.yaml", cam0_.T_BS * T_sensor_rect);
+    keep_imu_span(*imu_, timestamps_.front(), timestamps_.back(), imu_path_);
   }
 
   EurocCameraSensor cam0_;

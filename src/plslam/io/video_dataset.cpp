@@ -25,6 +25,7 @@
 #include "plslam/io/calibration_file.h"
 #include "plslam/io/dataset_impl.h"
 #include "plslam/io/image_loading.h"
+#include "plslam/io/imu_input.h"
 #include "plslam/io/trajectory_io.h"
 
 namespace plslam::io {
@@ -97,6 +98,7 @@ class VideoDataset final : public Dataset {
     start_ = start;
     for (std::size_t i = 0; i < n; ++i) timestamps_.push_back(static_cast<double>(start + i) / fps_);
     load_ground_truth();
+    load_imu(options);
     try {
       (void)load(0);  // fail early on a file that decodes nothing, or frames of another size
     } catch (const InputEnded& e) {
@@ -184,6 +186,18 @@ class VideoDataset final : public Dataset {
     }
     gt_ = std::move(gt);
     gt_path_ = path;
+  }
+
+  // --imu and --imu-calib: the body frame of the IMU's T_BS is the rectified left camera, and the
+  // samples' nanoseconds are on the frames' clock (0 at the video's first frame).
+  void load_imu(const DatasetOptions& options) {
+    if (options.imu_csv.empty() != options.imu_calib.empty()) {
+      throw InputError(root_.string(), "--imu and --imu-calib go together");
+    }
+    if (options.imu_csv.empty()) return;
+    imu_path_ = options.imu_csv;
+    imu_ = read_imu(options.imu_csv, options.imu_calib, Eigen::Isometry3d::Identity());
+    keep_imu_span(*imu_, timestamps_.front(), timestamps_.back(), options.imu_csv);
   }
 
   double fps_ = 0;

@@ -15,8 +15,12 @@ namespace plslam::io {
 // Opens `video` as a Dataset (format kVideo, root() the video file). Timestamps are the frame
 // index over the video's frame rate, from 0 s at its first frame. Ground truth is optional: a
 // `ground_truth.tum` beside the video (TUM poses of the left camera, same clock), as
-// `plslam synth --format video` writes it. Throws InputError naming the file for a missing file,
-// one FFmpeg cannot open, frames that are not 2 * width x height of the calibration, or no frame.
+// `plslam synth --format video` writes it. An IMU is read when options names its two files
+// (imu_csv, imu_calib; io/imu_input.h): the samples' nanoseconds are on the same clock as the
+// frames (0 at the video's first frame, frame i at i / fps), the sensor.yaml's T_BS places the IMU
+// in the rectified left camera's frame, and the samples must span the selected frames. Throws
+// InputError naming the file for a missing file, one FFmpeg cannot open, frames that are not
+// 2 * width x height of the calibration, no frame, or a bad or too short IMU file.
 std::unique_ptr<Dataset> open_video_dataset(const std::filesystem::path& video,
                                             const std::filesystem::path& calibration,
                                             const DatasetOptions& options = {});
