@@ -170,6 +170,29 @@ TEST(SynthFormats, Euroc) {
   ASSERT_TRUE(ds->ground_truth().has_value());
   ASSERT_EQ(ds->ground_truth()->size(), 4u);
   expect_pose_near(ds->ground_truth()->at(2).T, seq.left_pose(2), 1e-9);
+  // The IMU (the body frame), read back by the project's reader: the synthetic samples exactly, on
+  // the images' clock (EuRoC stamps start at 1 s), covering the frames.
+  ASSERT_TRUE(ds->imu().has_value());
+  expect_pose_near(ds->imu()->T_imu_cam, T_BS0, 1e-12);
+  const SyntheticImu imu(seq, euroc_T_BS_cam0(), {}, imu_seed(seq.options()));
+  const auto& read = ds->imu()->samples;
+  ASSERT_GE(read.size(), 40u);
+  EXPECT_LE(read.front().t, 1.0);
+  EXPECT_GE(read.back().t, 1.15);
+  std::size_t matched = 0;
+  for (const ImuSample& r : read) {
+    for (const ImuSample& w : imu.samples()) {
+      if (std::abs(w.t + 1.0 - r.t) > 1e-9) continue;
+      EXPECT_EQ(r.gyro, w.gyro);
+      EXPECT_EQ(r.acc, w.acc);
+      ++matched;
+    }
+  }
+  EXPECT_EQ(matched, read.size());
+  const YAML::Node imu_yaml = YAML::LoadFile((mav / "imu0" / "sensor.yaml").string());
+  EXPECT_EQ(imu_yaml["rate_hz"].as<double>(), 200.0);
+  EXPECT_EQ(imu_yaml["gyroscope_noise_density"].as<double>(), kEurocAdis16448Noise.gyro_noise_density);
+
   const auto frame = ds->load(1);
   const cv::Mat raw = cv::imread((mav / "cam0" / "data" / "1050000000.png").string(), cv::IMREAD_GRAYSCALE);
   const double diff = cv::norm(frame.left, raw, cv::NORM_L1) / raw.total();

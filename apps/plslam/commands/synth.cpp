@@ -30,6 +30,10 @@ struct Options {
   double loop_overlap = plslam::synth::SequenceOptions{}.loop_overlap;
   double fps = 0;  // 0: the preset's
   bool motion_blur = false;
+  std::string motion = "walk";
+  std::string imu_noise = "none";
+  double imu_rate = 200;
+  double imu_time_offset = 0;
   bool force = false;
   int threads = 0;
 };
@@ -107,13 +111,23 @@ int run(const Options& o) {
   so.loop = o.loop;
   so.loop_overlap = o.loop_overlap;
   so.motion_blur = o.motion_blur;
+  so.motion = plslam::synth::parse_motion_profile(o.motion);
+  plslam::synth::ImuSynthOptions imu;
+  imu.rate_hz = o.imu_rate;
+  imu.noise_scale = plslam::synth::parse_imu_noise(o.imu_noise);
+  imu.time_offset = o.imu_time_offset;
   const auto format = plslam::synth::parse_output_format(o.format.empty() ? o.preset : o.format);
   const plslam::synth::Sequence seq(so);  // checks the options first: they are the likelier mistake
   const fs::path out = checked_out_folder(o.out, o.force);
   plslam::app::install_stop_signals();
-  spdlog::info("synth: {} scene, {} preset ({}x{} @ {:.4g} Hz, baseline {} m), {} frames, path {:.1f} m at {:.2f} m/s{}",
+  spdlog::info("synth: {} scene, {} preset ({}x{} @ {:.4g} Hz, baseline {} m), {} frames, path {:.1f} m at {:.2f} m/s{}{}",
                o.scene, so.preset.name, so.preset.width, so.preset.height, so.preset.fps, so.preset.baseline,
-               o.frames, seq.path().length(), seq.path().speed(), o.loop ? ", loop" : "");
+               o.frames, seq.path().length(), seq.path().speed(), o.loop ? ", loop" : "",
+               so.motion == plslam::synth::MotionProfile::kWalk ? "" : ", " + o.motion + " motion");
+  if (format == plslam::synth::OutputFormat::kEuroc) {
+    spdlog::info("synth: IMU at {} Hz, noise {}{}", imu.rate_hz, o.imu_noise,
+                 imu.time_offset != 0 ? fmt::format(", camera clock {:+.4f} s against the IMU's", imu.time_offset) : "");
+  }
   if (o.path_seed != 0) {
     const auto v = plslam::synth::path_variation(o.path_seed, seq.scene().vehicle);
     spdlog::info("synth: path seed {}: starts at {:.0f} % of the loop, {}, {:+.2f} m to the left, {:+.2f} m up",
@@ -130,7 +144,7 @@ int run(const Options& o) {
           spdlog::info("synth: {}/{} frames, ETA {:.0f} s", done, total, plslam::cli::eta_seconds(start, done, total));
         }
       },
-      o.threads, [] { return plslam::app::stop_requested(); });
+      o.threads, [] { return plslam::app::stop_requested(); }, imu);
   if (!complete || plslam::app::stop_requested()) {
     spdlog::warn("synth: stopped by {}; nothing written to {}", plslam::app::stop_signal_name(), out.string());
     return plslam::app::stop_exit_code();
@@ -174,6 +188,22 @@ plslam::cli::CommandRegistration reg({"synth", "Render a synthetic stereo sequen
                                             ->capture_default_str()
                                             ->needs(loop);
                                         sub.add_flag("--motion-blur", o->motion_blur, "Blur proportional to the motion");
+                                        sub.add_option("--motion", o->motion,
+                                                       "walk (the scene's own motion) | handheld (quick looks aside up "
+                                                       "to 3 rad/s, hand shake) | drone (fast yaw turns, swoops with "
+                                                       "tilt, vibration)")
+                                            ->capture_default_str();
+                                        sub.add_option("--imu-noise", o->imu_noise,
+                                                       "EuRoC layout's IMU: none (exact, zero biases) | euroc (ADIS16448 "
+                                                       "noise and random walks, non-zero biases) | F (those scaled by F)")
+                                            ->capture_default_str();
+                                        sub.add_option("--imu-rate", o->imu_rate, "IMU rate in Hz")
+                                            ->check(CLI::Range(1.0, 100000.0))
+                                            ->capture_default_str();
+                                        sub.add_option("--imu-time-offset", o->imu_time_offset,
+                                                       "The camera's clock against the IMU's in seconds (t_cam = t_imu + S)")
+                                            ->check(CLI::Range(-0.5, 0.5))
+                                            ->capture_default_str();
                                         sub.add_flag("--force", o->force, "Replace a non-empty --out folder");
                                         sub.add_option("--threads", o->threads, "Rendering threads (0: all cores)")
                                             ->check(CLI::Range(0, 1024))

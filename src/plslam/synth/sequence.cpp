@@ -46,7 +46,7 @@ double choose_speed(const Scene& scene, const SequenceOptions& o) {
 Sequence::Sequence(const SequenceOptions& options)
     : options_(options),
       scene_(build_scene(options.scene, options.seed)),
-      path_(scene_, choose_speed(scene_, options), options.seed, options.path_seed),
+      path_(scene_, choose_speed(scene_, options), options.seed, options.path_seed, options.motion),
       sensor_(options.preset.width, options.preset.height, options.seed) {}
 
 StereoCalibration Sequence::calibration() const {

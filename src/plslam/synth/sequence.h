@@ -39,6 +39,7 @@ struct SequenceOptions {
   bool loop = false;         // traverse the whole closed path (>= 30 m) and return to the start
   double loop_overlap = 0.03;  // with loop: share of the path travelled again after the return, in [0, 1]
   bool motion_blur = false;  // integrate over the shutter time, proportional to the motion
+  MotionProfile motion = MotionProfile::kWalk;
 };
 
 class Sequence {

@@ -88,8 +88,51 @@ void write_sensor_yaml(const fs::path& p, const Sequence& seq, const Eigen::Isom
       << "distortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n";
 }
 
+void write_imu(const SyntheticImu& imu, const fs::path& dir) {
+  {
+    auto csv = open_out(dir / "data.csv");
+    csv << "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
+           "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
+    for (const ImuSample& s : imu.samples()) {
+      // The IMU's clock on the images' time base: EuRoC stamps start at 1 s (euroc_timestamp_ns).
+      csv << fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n", 1'000'000'000LL + std::llround(s.t * 1e9),
+                         s.gyro.x(), s.gyro.y(), s.gyro.z(), s.acc.x(), s.acc.y(), s.acc.z());
+    }
+  }
+  const ImuNoise n = imu.noise();
+  auto out = open_out(dir / "sensor.yaml");
+  out << "%YAML:1.0\nsensor_type: imu\ncomment: plslam synth IMU"
+      << (imu.options().noise_scale > 0 ? fmt::format(" (EuRoC ADIS16448 noise x {})", imu.options().noise_scale)
+                                        : std::string(" (exact samples; the noise values are EuRoC's nominal ones)"))
+      << "\n\n# Sensor extrinsics wrt. the body-frame.\nT_BS:\n" << matrix_yaml(Eigen::Isometry3d::Identity())
+      << fmt::format("rate_hz: {}\n\n", imu.options().rate_hz)
+      << fmt::format("gyroscope_noise_density: {:.9g}     # [ rad / s / sqrt(Hz) ]\n", n.gyro_noise_density)
+      << fmt::format("gyroscope_random_walk: {:.9g}       # [ rad / s^2 / sqrt(Hz) ]\n", n.gyro_random_walk)
+      << fmt::format("accelerometer_noise_density: {:.9g} # [ m / s^2 / sqrt(Hz) ]\n", n.acc_noise_density)
+      << fmt::format("accelerometer_random_walk: {:.9g}   # [ m / s^3 / sqrt(Hz) ]\n", n.acc_random_walk);
+}
+
+// EuRoC's state_groundtruth_estimate0 columns: position, orientation (w, x, y, z), velocity and
+// the true biases of the IMU (= body) frame.
+void write_state_ground_truth(const Sequence& seq, const SyntheticImu& imu, const fs::path& path) {
+  auto out = open_out(path);
+  out << "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z [], "
+         "v_RS_R_x [m s^-1], v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], "
+         "b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n";
+  for (std::size_t i = 0; i < seq.size(); ++i) {
+    const ImuTrueState s = imu.true_state(seq.time(i));
+    const Eigen::Vector3d& p = s.T_wb.translation();
+    const Eigen::Quaterniond q(s.T_wb.linear());
+    out << fmt::format("{},{:.12g},{:.12g},{:.12g},{:.12g},{:.12g},{:.12g},{:.12g},{:.12g},{:.12g},{:.12g},"
+                       "{:.12g},{:.12g},{:.12g},{:.12g},{:.12g},{:.12g}\n",
+                       euroc_timestamp_ns(seq, i), p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), s.v_wb.x(),
+                       s.v_wb.y(), s.v_wb.z(), s.bg.x(), s.bg.y(), s.bg.z(), s.ba.x(), s.ba.y(), s.ba.z());
+  }
+}
+
 void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const Eigen::Isometry3d& T_out_world,
-                               const std::vector<double>& times, const char* frame_name) {
+                               const std::vector<double>& times, const char* frame_name,
+                               const SyntheticImu* imu = nullptr) {
   {
     auto out = open_out(dir / "segments_3d.txt");
     out << "# x1 y1 z1 x2 y2 z2 [m], straight scene edges, frame: " << frame_name << "\n";
@@ -117,6 +160,17 @@ void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const E
                       {"baseline_m", o.preset.baseline}, {"path_length_m", seq.path().length()},
                       {"speed_mps", seq.path().speed()}, {"frame", frame_name}};
   j["path_seed"] = o.path_seed;
+  j["motion"] = to_string(o.motion);
+  if (imu) {
+    const auto& io = imu->options();
+    const Eigen::Vector3d &bg = imu->initial_gyro_bias(), &ba = imu->initial_acc_bias();
+    j["imu"] = {{"rate_hz", io.rate_hz},
+                {"noise_scale", io.noise_scale},
+                {"time_offset_s", io.time_offset},
+                {"samples", imu->samples().size()},
+                {"initial_gyro_bias", {bg.x(), bg.y(), bg.z()}},
+                {"initial_acc_bias", {ba.x(), ba.y(), ba.z()}}};
+  }
   // The scene's world from the ground truth's frame (row-major 4x4): KITTI's ground truth starts
   // at each sequence's first camera, so runs on two paths through one scene (a saved map, then
   // localization) are compared in this common world.
@@ -225,8 +279,10 @@ bool write_video(const Sequence& seq, const fs::path& dir, const Progress& progr
 
 }  // namespace
 
+std::uint64_t imu_seed(const SequenceOptions& o) { return o.seed * 0x2545F4914F6CDD1DULL ^ (o.path_seed << 17) ^ 0x1BB; }
+
 bool write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat format, const Progress& progress,
-                    int threads, const Cancelled& cancelled) {
+                    int threads, const Cancelled& cancelled, const ImuSynthOptions& imu_options) {
   if (format == OutputFormat::kVideo) return write_video(seq, dir, progress, threads, cancelled);
   const std::size_t n = seq.size();
   if (format == OutputFormat::kEuroc) {
@@ -243,13 +299,10 @@ bool write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat forma
       for (std::size_t i = 0; i < n; ++i) csv << fmt::format("{0},{0}.png\n", euroc_timestamp_ns(seq, i));
       write_sensor_yaml(cdir / "sensor.yaml", seq, cam == 0 ? T_BS0 : T_BS0 * T_c0c1, cam);
     }
-    Trajectory body;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double t = static_cast<double>(euroc_timestamp_ns(seq, i)) * 1e-9;
-      times.push_back(t);
-      body.push_back({t, seq.left_pose(i) * T_BS0.inverse()});  // T_wb = T_wc * T_cb
-    }
-    io::write_trajectory(mav / "state_groundtruth_estimate0" / "data.csv", body, io::TrajectoryFormat::kEuroc);
+    for (std::size_t i = 0; i < n; ++i) times.push_back(static_cast<double>(euroc_timestamp_ns(seq, i)) * 1e-9);
+    const SyntheticImu imu(seq, T_BS0, imu_options, imu_seed(seq.options()));  // IMU = body frame
+    write_imu(imu, mav / "imu0");
+    write_state_ground_truth(seq, imu, mav / "state_groundtruth_estimate0" / "data.csv");
     const bool complete = render_all(seq, progress, threads, cancelled, [&](std::size_t i, const StereoImages& im) {
       const std::string name = fmt::format("{}.png", euroc_timestamp_ns(seq, i));
       write_png(mav / "cam0" / "data" / name, im.left);
@@ -257,7 +310,7 @@ bool write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat forma
     });
     if (!complete) return false;
     // Last, so that synth/synth.json marks a complete sequence.
-    write_ground_truth_extras(seq, mav / "synth", Eigen::Isometry3d::Identity(), times, "euroc world (z up)");
+    write_ground_truth_extras(seq, mav / "synth", Eigen::Isometry3d::Identity(), times, "euroc world (z up)", &imu);
     return true;
   }
   const fs::path sdir = dir / "sequences" / "00";

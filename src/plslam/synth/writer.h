@@ -3,7 +3,9 @@
 //
 //   EuRoC (--format euroc):
 //     DIR/mav0/cam{0,1}/data.csv, data/<ns>.png, sensor.yaml   (exactly the ASL layout)
-//     DIR/mav0/state_groundtruth_estimate0/data.csv           (body = IMU-like frame)
+//     DIR/mav0/imu0/data.csv, sensor.yaml                     (the synthetic IMU, synth/imu_synth.h)
+//     DIR/mav0/state_groundtruth_estimate0/data.csv           (body = IMU frame: pose, velocity,
+//                                                              true gyro and accelerometer biases)
 //     DIR/mav0/synth/                                         (extra ground truth, below)
 //   KITTI (--format kitti):
 //     DIR/sequences/00/{image_0,image_1}/NNNNNN.png, calib.txt, times.txt
@@ -27,6 +29,7 @@
 
 #include <Eigen/Geometry>
 
+#include "plslam/synth/imu_synth.h"
 #include "plslam/synth/sequence.h"
 
 namespace plslam::synth {
@@ -51,7 +54,12 @@ using Cancelled = std::function<bool()>;
 
 // Renders every frame (in parallel when `threads` != 1) and writes the dataset into `dir`.
 // Returns false, with the dataset incomplete, when `cancelled` stopped it.
+// The EuRoC layout also gets the IMU of `imu` (the other layouts have none).
 bool write_sequence(const Sequence& seq, const std::filesystem::path& dir, OutputFormat format,
-                    const Progress& progress = {}, int threads = 0, const Cancelled& cancelled = {});
+                    const Progress& progress = {}, int threads = 0, const Cancelled& cancelled = {},
+                    const ImuSynthOptions& imu = {});
+
+// The seed of the IMU's noise and biases for a sequence.
+std::uint64_t imu_seed(const SequenceOptions& o);
 
 }  // namespace plslam::synth
