@@ -88,3 +88,6 @@ plslam_test(TimeRobustness.BlankImageMidSequenceIsSkippedAndKeepsAlignment COST 
 # A 480-frame office render and sequential runs of up to 480 frames, in one process so that the
 # render is made once; the same relocalization code runs in the kidnapped tests.
 plslam_suite(BlackOut COST 80 LABELS sanitizer_skip)
+# A 110-frame render and run (5 s in Release): the initialisation's code runs under the sanitizers in
+# RunImuInit.EurocMicro* (the same path through plslam run) and ViInitializer.*.
+plslam_test(RunImuInit.RenderedHandheldWalkIsInitialisedNearTheTruth COST 5 LABELS sanitizer_skip)

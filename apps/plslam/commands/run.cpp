@@ -31,6 +31,7 @@
 #include "plslam/io/video_dataset.h"
 #include "plslam/system/input_aligned_trajectory.h"
 #include "plslam/system/map_file.h"
+#include "plslam/system/imu_init_monitor.h"
 #include "plslam/system/run_report.h"
 #include "plslam/system/slam_system.h"
 #include "plslam/system/system_config.h"
@@ -226,6 +227,10 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     loaded.reset();
   }
   system::RunReport report;
+  // With an IMU: visual-inertial initialisation, reported (tracking does not use it yet).
+  const ImuData* imu = ds && ds->imu() ? &*ds->imu() : input.camera_imu ? &*input.camera_imu : nullptr;
+  std::optional<system::ImuInitMonitor> imu_init;
+  if (imu && !args.localize) imu_init.emplace(*imu);
   app::install_stop_signals();
   std::string fatal;
   const auto start = std::chrono::steady_clock::now();
@@ -238,6 +243,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   auto process = [&](const io::StereoFrame& frame) {
     const auto r = slam.process(frame);
     report.add(r);
+    if (imu_init) imu_init->add(r);
     reached = frame.index + 1;
     ++done;
     const auto now = std::chrono::steady_clock::now();
@@ -438,6 +444,8 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   stats["live"] = live_stats;
   stats["realtime"] = realtime_stats;
   stats["input"] = input_json(input);
+  stats["imu"] = imu_init ? imu_init->report() : nlohmann::json(nullptr);
+  if (imu_init) spdlog::info("{}", imu_init->summary());
   if (ds && ds->ground_truth()) {
     // Tracked poses only: a prediction made while lost is not an estimate to score.
     try {
