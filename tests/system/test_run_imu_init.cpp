@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "plslam/io/text_table.h"
 #include "support/test_support.h"
 
 namespace plslam {
@@ -27,16 +28,11 @@ nlohmann::json run_imu(const fs::path& seq, const fs::path& out) {
 
 // Columns 11-13 of state_groundtruth_estimate0 (the gyro bias) in the row nearest `t`.
 Eigen::Vector3d true_gyro_bias(const fs::path& mav0, double t) {
-  std::ifstream in(mav0 / "state_groundtruth_estimate0" / "data.csv");
   Eigen::Vector3d best = Eigen::Vector3d::Constant(NAN);
   double best_dt = 1e300;
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<double> v;
-    std::stringstream ss(line);
-    for (std::string f; std::getline(ss, f, ',');) v.push_back(std::stod(f));
-    if (v.size() < 17) continue;
-    if (std::abs(v[0] * 1e-9 - t) < best_dt) {
+  for (const auto& row : io::read_numeric_rows(mav0 / "state_groundtruth_estimate0" / "data.csv")) {
+    const auto& v = row.values;
+    if (v.size() >= 17 && std::abs(v[0] * 1e-9 - t) < best_dt) {
       best_dt = std::abs(v[0] * 1e-9 - t);
       best = Eigen::Vector3d(v[11], v[12], v[13]);
     }

@@ -148,13 +148,13 @@ ViInitResult initialize_visual_inertial(std::span<const ViKeyframe> keyframes, c
   const Eigen::Isometry3d T_cb = imu.T_imu_cam.inverse();
   const std::size_t n = keyframes.size();
   std::vector<Eigen::Matrix3d> R(n);
-  std::vector<Eigen::Vector3d> p(n), p_measured(n);
+  std::vector<Eigen::Vector3d> p(n);
   for (std::size_t k = 0; k < n; ++k) {
     const Eigen::Isometry3d T_wb = keyframes[k].T_wc * T_cb;
     R[k] = T_wb.linear();
     p[k] = T_wb.translation();
   }
-  p_measured = p;
+  const std::vector<Eigen::Vector3d> p_measured = p;  // the priors' centres; p moves
   std::vector<Preintegration> pre;
   ImuBias bias;
   try {

@@ -86,28 +86,30 @@ ImuNoise SyntheticImu::noise() const {
   return n;
 }
 
-ImuSample SyntheticImu::ideal(double t) const {
+SyntheticImu::BodyMotion SyntheticImu::body_motion(double t) const {
   const CameraKinematics k = seq_.path().kinematics(t);
-  const Eigen::Matrix3d R_cb = T_bc_.linear().transpose();
-  const Eigen::Vector3d t_cb = -(R_cb * T_bc_.translation());
-  // T_wb = T_wc * T_cb, differentiated with R_cb and t_cb constant.
-  const Eigen::Matrix3d R_wb = k.T_wc.linear() * R_cb;
-  const Eigen::Matrix3d W = R_wb.transpose() * (k.R_dot * R_cb);  // hat(omega_b), up to rounding
-  const Eigen::Vector3d a_wb = k.acceleration + k.R_ddot * t_cb;
+  const Eigen::Isometry3d T_cb = T_bc_.inverse();  // constant: differentiated through R_wc only
+  return {k.T_wc * T_cb, k.R_dot * T_cb.linear(), k.velocity + k.R_dot * T_cb.translation(),
+          k.acceleration + k.R_ddot * T_cb.translation()};
+}
+
+ImuSample SyntheticImu::ideal(double t) const {
+  const BodyMotion b = body_motion(t);
+  const Eigen::Matrix3d R_wb = b.T_wb.linear();
+  const Eigen::Matrix3d W = R_wb.transpose() * b.R_dot;  // hat(omega_b), up to rounding
   ImuSample s;
   s.t = t;
   s.gyro = 0.5 * Eigen::Vector3d(W(2, 1) - W(1, 2), W(0, 2) - W(2, 0), W(1, 0) - W(0, 1));
-  s.acc = R_wb.transpose() * (a_wb + Eigen::Vector3d(0, 0, kGravity));
+  s.acc = R_wb.transpose() * (b.acceleration + Eigen::Vector3d(0, 0, kGravity));
   return s;
 }
 
 ImuTrueState SyntheticImu::true_state(double t) const {
-  const CameraKinematics k = seq_.path().kinematics(t);
-  const Eigen::Isometry3d T_cb = T_bc_.inverse();
+  const BodyMotion b = body_motion(t);
   ImuTrueState s;
   s.t = t;
-  s.T_wb = k.T_wc * T_cb;
-  s.v_wb = k.velocity + k.R_dot * T_cb.translation();
+  s.T_wb = b.T_wb;
+  s.v_wb = b.velocity;
   // Biases between the samples around t (IMU clock t - offset).
   const double t_imu = t - options_.time_offset;
   const auto it = std::lower_bound(samples_.begin(), samples_.end(), t_imu,

@@ -56,6 +56,14 @@ class SyntheticImu {
   ImuSample ideal(double t) const;
 
  private:
+  // The body's (IMU's) motion at sequence time t: T_wb = T_wc * T_cb, and its derivatives.
+  struct BodyMotion {
+    Eigen::Isometry3d T_wb;
+    Eigen::Matrix3d R_dot;
+    Eigen::Vector3d velocity, acceleration;
+  };
+  BodyMotion body_motion(double t) const;
+
   const Sequence& seq_;
   Eigen::Isometry3d T_bc_;
   ImuSynthOptions options_;
