@@ -92,6 +92,40 @@ TEST(Map, CullingAKeyframeReparentsChildrenAndKeepsRelativePose) {
   EXPECT_EQ(f.k[0]->tracked_map_points(1), 5);
 }
 
+TEST(Map, TransformWorldKeepsEveryObjectWhereTheCamerasSeeIt) {
+  Fixture f;
+  for (int i = 0; i < 3; ++i) {
+    f.k[i]->set_pose(geometry::SE3::exp((geometry::Vector6d() << 0.3 * i, -0.2, 0.1 * i, 0.05, -0.1 * i, 0.2).finished()));
+  }
+  MapLine* line = f.map.create_line(Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(2, 2, 4), f.k[0], 0);
+  for (MapPoint* p : f.map.points()) p->update_normal_and_depth();
+  f.k[1]->set_bad();  // a culled keyframe still anchors frames: it turns too
+  f.map.erase_keyframe(f.k[1]);
+  const auto points = f.map.points();
+  ASSERT_FALSE(points.empty());
+  std::vector<Eigen::Vector3d> in_camera, normals;
+  for (MapPoint* p : points) {
+    in_camera.push_back(f.k[2]->pose() * p->position());
+    normals.push_back(p->normal());
+  }
+  ASSERT_GT(normals.front().norm(), 0.5);
+  const Eigen::Vector3d s0 = f.k[1]->pose() * line->start(), e0 = f.k[0]->pose() * line->end();
+  const Eigen::Vector3d c1 = f.k[1]->camera_center();
+  const long changes = f.map.changes();
+
+  const geometry::SE3 T(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix(),
+                        Eigen::Vector3d(0.5, -1, 2));
+  f.map.transform_world(T);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    EXPECT_LT((f.k[2]->pose() * points[i]->position() - in_camera[i]).norm(), 1e-12);
+    EXPECT_LT((points[i]->normal() - T.rotation() * normals[i]).norm(), 1e-12);
+  }
+  EXPECT_LT((f.k[1]->pose() * line->start() - s0).norm(), 1e-12);
+  EXPECT_LT((f.k[0]->pose() * line->end() - e0).norm(), 1e-12);
+  EXPECT_LT((f.k[1]->camera_center() - T * c1).norm(), 1e-12);
+  EXPECT_GT(f.map.changes(), changes);  // a viewer redraws
+}
+
 TEST(Map, FirstKeyframeIsNeverCulled) {
   Fixture f;
   f.k[0]->set_bad();

@@ -172,8 +172,12 @@ class BlackOut : public ::testing::Test {
   static nlohmann::json run_with_black_out(std::size_t black_from, std::size_t frames) {
     const fs::path seq = tmp_->path() / fmt::format("black-{}", black_from);
     fs::create_directories(seq / "mav0");
+    // Vision only, as these frame-exact cases were measured: with the IMU, the world turns to the
+    // gravity-aligned one at 5 s, which changes the rounding of every later solve, and with it
+    // which of two right answers the run takes after a black-out (frame 440: tracked across it
+    // instead of relocalized, its loop at 464).
     for (const auto& e : fs::directory_iterator(office() / "mav0")) {
-      fs::create_directory_symlink(e.path(), seq / "mav0" / e.path().filename());
+      if (e.path().filename() != "imu0") fs::create_directory_symlink(e.path(), seq / "mav0" / e.path().filename());
     }
     for (const char* cam : {"cam0", "cam1"}) {  // own copies of the camera folders, images linked
       const fs::path dst = seq / "mav0" / cam;

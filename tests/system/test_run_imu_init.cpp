@@ -4,6 +4,7 @@
 // initialised with gravity and the gyro bias near the truth.
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -88,6 +89,34 @@ TEST(RunImuInit, RenderedHandheldWalkIsInitialisedNearTheTruth) {
               bg_true.norm());
   EXPECT_LT(g_err, 0.5);
   EXPECT_LT(bg_err, std::max(0.1 * bg_true.norm(), 2e-4));
+
+  // The world then turned to the gravity-aligned one: every output pose, also those of the frames
+  // before the initialisation, has the camera's tilt of the rendered world (z up), and the first
+  // camera keeps its place.
+  ASSERT_TRUE(imu["world"]["gravity_aligned"].get<bool>()) << imu["world"].dump();
+  std::map<long, Eigen::Matrix3d> truth;  // by time in ms
+  for (const auto& row : io::read_numeric_rows(seq / "mav0" / "synth" / "left_camera.tum")) {
+    const auto& v = row.values;
+    truth[std::lround(v[0] * 1000)] = Eigen::Quaterniond(v[7], v[4], v[5], v[6]).toRotationMatrix();
+  }
+  for (const char* file : {"trajectory.tum", "keyframes.tum"}) {
+    const auto rows = io::read_numeric_rows(tmp.path() / "run" / file);
+    ASSERT_GT(rows.size(), 10u) << file;
+    double worst = 0;
+    for (const auto& row : rows) {
+      const auto& v = row.values;
+      const Eigen::Matrix3d R = Eigen::Quaterniond(v[7], v[4], v[5], v[6]).toRotationMatrix();
+      const auto it = truth.find(std::lround(v[0] * 1000));
+      ASSERT_NE(it, truth.end()) << file << " t " << v[0];
+      const Eigen::Vector3d down = R.transpose() * Eigen::Vector3d(0, 0, -1);
+      const Eigen::Vector3d down_true = it->second.transpose() * Eigen::Vector3d(0, 0, -1);
+      worst = std::max(worst, std::atan2(down.cross(down_true).norm(), down.dot(down_true)) * 180 / M_PI);
+    }
+    std::printf("%s: %zu poses, worst tilt error %.3f deg\n", file, rows.size(), worst);
+    EXPECT_LT(worst, 0.5) << file;
+    const auto& first = rows.front().values;
+    EXPECT_LT(Eigen::Vector3d(first[1], first[2], first[3]).norm(), 1e-9) << file;
+  }
 }
 
 }  // namespace

@@ -227,10 +227,10 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     loaded.reset();
   }
   system::RunReport report;
-  // With an IMU: visual-inertial initialisation, reported (tracking does not use it yet).
+  // With an IMU: visual-inertial initialisation, and then a gravity-aligned world (tracking does
+  // not use the IMU otherwise yet).
   const ImuData* imu = ds && ds->imu() ? &*ds->imu() : input.camera_imu ? &*input.camera_imu : nullptr;
-  std::optional<system::ImuInitMonitor> imu_init;
-  if (imu && !args.localize) imu_init.emplace(*imu);
+  if (imu) slam.set_imu(*imu);
   app::install_stop_signals();
   std::string fatal;
   const auto start = std::chrono::steady_clock::now();
@@ -243,7 +243,6 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   auto process = [&](const io::StereoFrame& frame) {
     const auto r = slam.process(frame);
     report.add(r);
-    if (imu_init) imu_init->add(r);
     reached = frame.index + 1;
     ++done;
     const auto now = std::chrono::steady_clock::now();
@@ -444,8 +443,13 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   stats["live"] = live_stats;
   stats["realtime"] = realtime_stats;
   stats["input"] = input_json(input);
-  stats["imu"] = imu_init ? imu_init->report() : nlohmann::json(nullptr);
-  if (imu_init) spdlog::info("{}", imu_init->summary());
+  stats["imu"] = slam.imu_report();
+  if (const auto* imu_init = slam.imu_init()) {
+    spdlog::info("{}", imu_init->summary());
+    if (const auto& g = slam.gravity_alignment()) {
+      spdlog::info("world: gravity-aligned (z up) from frame {} on; every output is in it", g->from_frame);
+    }
+  }
   if (ds && ds->ground_truth()) {
     // Tracked poses only: a prediction made while lost is not an estimate to score.
     try {

@@ -76,6 +76,8 @@ class Landmark {
   // false (and `out` untouched) while the landmark has no descriptor.
   bool copy_descriptor(std::array<uint8_t, 32>& out) const;
   Eigen::Vector3d normal() const;
+  // The world turned by R (Map::transform_world): the mean viewing direction turns with it.
+  void rotate_normal(const Eigen::Matrix3d& R);
   double min_distance() const;
   double max_distance() const;
 

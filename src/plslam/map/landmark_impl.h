@@ -136,6 +136,12 @@ double Landmark<D>::max_distance() const {
 }
 
 template <class D>
+void Landmark<D>::rotate_normal(const Eigen::Matrix3d& R) {
+  std::lock_guard lock(mutex_);
+  normal_ = R * normal_;
+}
+
+template <class D>
 void Landmark<D>::set_normal_and_range(const Eigen::Vector3d& normal, double min_distance, double max_distance) {
   std::lock_guard lock(mutex_);
   normal_ = normal;

@@ -136,6 +136,32 @@ Map::Reclaimed Map::reclaim(const std::function<void()>& drop_bad) {
   return r;
 }
 
+void Map::transform_world(const geometry::SE3& T_new_old) {
+  std::lock_guard update(update_mutex_);
+  const geometry::SE3 T_old_new = T_new_old.inverse();
+  const Eigen::Matrix3d& R = T_new_old.rotation();
+  // The objects' own locks are taken after mutex_ is released, as everywhere else.
+  std::vector<KeyFrame*> keyframes;
+  std::vector<MapPoint*> points;
+  std::vector<MapLine*> lines;
+  {
+    std::lock_guard lock(mutex_);
+    for (const auto& kf : all_keyframes_) keyframes.push_back(kf.get());
+    for (const auto& p : all_points_) points.push_back(p.get());
+    for (const auto& l : all_lines_) lines.push_back(l.get());
+  }
+  for (KeyFrame* kf : keyframes) kf->set_pose(kf->pose() * T_old_new);
+  for (MapPoint* p : points) {
+    p->set_position(T_new_old * p->position());
+    p->rotate_normal(R);
+  }
+  for (MapLine* l : lines) {
+    l->set_endpoints(T_new_old * l->start(), T_new_old * l->end());
+    l->rotate_normal(R);
+  }
+  ++changes_;
+}
+
 Map::Reclaimed Map::reclaimed() const {
   std::lock_guard lock(mutex_);
   return reclaimed_;

@@ -64,6 +64,13 @@ class Map {
   // Totals freed so far.
   Reclaimed reclaimed() const;
 
+  // Re-expresses the whole map in another world frame: x_new = T_new_old x_old for every keyframe
+  // (culled ones too: they still anchor frames), point, line and viewing direction (a gravity-
+  // aligned world once the IMU is initialised, system/slam_system). Holds update_mutex(); call it
+  // where no other thread writes the map (as reclaim()); whoever keeps a world pose across frames
+  // (the tracker) re-expresses it too.
+  void transform_world(const geometry::SE3& T_new_old);
+
   std::vector<KeyFrame*> keyframes() const;  // active, by id
   std::vector<MapPoint*> points() const;
   std::vector<MapLine*> lines() const;

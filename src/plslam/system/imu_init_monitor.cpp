@@ -8,14 +8,14 @@ ImuInitMonitor::ImuInitMonitor(const ImuData& imu, ImuInitMonitorOptions options
   options_.init.validate();
 }
 
-void ImuInitMonitor::add(const FrameResult& frame) {
+void ImuInitMonitor::add(double timestamp, const std::optional<Eigen::Isometry3d>& T_world_camera) {
   if (accepted_) return;
-  if (!frame.track.tracked || !frame.T_world_camera) {
+  if (!T_world_camera) {
     window_.clear();
     return;
   }
-  if (!window_.empty() && frame.timestamp - window_.back().t < options_.min_frame_spacing_s) return;
-  window_.push_back({frame.timestamp, *frame.T_world_camera});
+  if (!window_.empty() && timestamp - window_.back().t < options_.min_frame_spacing_s) return;
+  window_.push_back({timestamp, *T_world_camera});
   while (window_.back().t - window_.front().t > options_.max_window_s) window_.erase(window_.begin());
   if (window_.back().t - last_attempt_t_ < options_.attempt_every_s) return;
   if (window_.back().t - window_.front().t < options_.init.min_span_s) return;

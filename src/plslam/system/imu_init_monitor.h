@@ -2,17 +2,17 @@
 // Visual-inertial initialisation during a run (inertial/vi_initializer.h): the tracked frames'
 // poses since tracking began, with the input's IMU, are tried every `attempt_every_s` until an
 // initialisation is accepted. A frame without a trusted pose breaks the motion and starts the
-// window again. Part 1 of the IMU work reports the result (stats.json "imu", the summary); tracking
-// does not use it yet, and the outputs stay in the first camera's world.
+// window again. The system (slam_system.h) turns its world to the gravity-aligned one once it is
+// accepted; tracking does not use the IMU otherwise yet.
 #include <optional>
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "plslam/core/imu.h"
 #include "plslam/inertial/vi_initializer.h"
-#include "plslam/system/slam_system.h"
 
 namespace plslam::system {
 
@@ -27,7 +27,8 @@ class ImuInitMonitor {
  public:
   ImuInitMonitor(const ImuData& imu, ImuInitMonitorOptions options = {});
 
-  void add(const FrameResult& frame);
+  // One frame: its time and pose (T_world_camera), nullopt when it has no trusted pose.
+  void add(double timestamp, const std::optional<Eigen::Isometry3d>& T_world_camera);
   bool initialised() const { return accepted_.has_value(); }
   // The accepted initialisation, else the last attempt (refused), else nothing tried yet.
   const std::optional<inertial::ViInitResult>& result() const { return accepted_ ? accepted_ : last_; }

@@ -133,7 +133,13 @@ FrameResult System::process(const io::StereoFrame& frame) {
     mapping_waits_.add(ms_since(tw));
     merge_due_global_ba(static_cast<long>(frame.index), frame.timestamp);
     start_loop_job();
-    if (!ba_in_flight_ && !loop_job_.joinable() && !correction_open()) reclaim_culled();
+    if (!ba_in_flight_ && !loop_job_.joinable() && !correction_open()) {
+      reclaim_culled();
+      // No global BA either, started or computed and not merged: its result is in the old world.
+      if (global_ba_merge_at_ < 0) align_world_with_gravity(static_cast<long>(frame.index));
+    }
+  } else {
+    align_world_with_gravity(static_cast<long>(frame.index));
   }
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
@@ -155,6 +161,7 @@ FrameResult System::process(const io::StereoFrame& frame) {
     reclaim_culled();
     pose_now();
   }
+  if (imu_init_) imu_init_->add(r.timestamp, r.T_world_camera);
   last_timestamp_ = frame.timestamp;
   r.rss_mb = core::resident_memory_mb();
   return r;
@@ -201,6 +208,42 @@ void System::reclaim_culled() {
     reclaim_stats_.ms.push_back(ms_since(t0));
   }
   mapper_->resume();
+}
+
+void System::set_imu(const ImuData& imu, ImuInitMonitorOptions options) {
+  if (!tracker_->records().empty()) throw std::logic_error("System::set_imu: after the first frame");
+  if (options_.localization_only) return;
+  imu_init_.reset();
+  imu_data_ = imu;
+  imu_init_.emplace(*imu_data_, options);
+}
+
+void System::align_world_with_gravity(long frame_id) {
+  if (map_loaded_ || gravity_alignment_ || !imu_init_ || !imu_init_->initialised()) return;
+  if (!mapper_->try_pause()) return;
+  if (!loop_closer_ || loop_closer_->try_pause()) {
+    // About the origin (the first keyframe's camera centre): only the tilt changes.
+    const geometry::SE3 T_new_old(imu_init_->result()->R_gw(), Eigen::Vector3d::Zero());
+    map_.transform_world(T_new_old);
+    tracker_->transform_world(T_new_old);
+    gravity_alignment_ = GravityAlignment{T_new_old.rotation(), frame_id};
+    if (loop_closer_) loop_closer_->resume();
+  }
+  mapper_->resume();
+}
+
+nlohmann::json System::imu_report() const {
+  if (!imu_init_) return nullptr;
+  nlohmann::json j = imu_init_->report();
+  nlohmann::json world = {{"gravity_aligned", gravity_alignment_.has_value()}};
+  if (gravity_alignment_) {
+    world["from_frame"] = gravity_alignment_->from_frame;
+    world["R_new_first_camera"] = j["initialisation"]["R_gravity_world"];  // row-major
+  } else {
+    world["kept"] = map_loaded_ ? "the loaded map's" : "the first keyframe's camera";
+  }
+  j["world"] = world;
+  return j;
 }
 
 void WaitStats::add(double ms) {
@@ -372,6 +415,8 @@ void System::finish() {
     loop_closer_->finish();
     loop_closer_->stop();
   }
+  // Accepted by the last frames: everything is at rest now.
+  if (!tracker_->records().empty()) align_world_with_gravity(tracker_->records().back().frame_id + 1);
   tracker_->settle_states();
 }
 
@@ -383,6 +428,7 @@ void System::load_map(const MapContents& contents) {
     std::lock_guard lock(map_.update_mutex());
     restore_map(contents, map_, database_.get());
   }
+  map_loaded_ = true;
   tracker_->start_in_loaded_map();
 }
 

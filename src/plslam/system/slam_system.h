@@ -19,6 +19,7 @@
 #include "plslam/loop/loop_closer.h"
 #include "plslam/mapping/local_mapper.h"
 #include "plslam/place/keyframe_database.h"
+#include "plslam/system/imu_init_monitor.h"
 #include "plslam/system/map_file.h"
 #include "plslam/tracking/frame_extractor.h"
 #include "plslam/tracking/tracker.h"
@@ -104,9 +105,29 @@ class System {
   // are filled in here.
   MapContents capture_map(MapFileMeta meta) const;
 
+  // Before the first frame: the input's IMU (a copy). Visual-inertial initialisation is tried on
+  // the tracked frames (ImuInitMonitor); once accepted, the world turns to the gravity-aligned one
+  // (z up, origin and yaw still the first keyframe's camera's) at the next frame boundary where no
+  // other thread works on the map: every keyframe, point, line and tracked pose, so that all
+  // outputs (also of the frames before) are in it. A loaded map keeps its world: the IMU is then
+  // only initialised and reported. Not with localization_only. Throws std::logic_error after the
+  // first frame.
+  void set_imu(const ImuData& imu, ImuInitMonitorOptions options = {});
+  // Null without an IMU.
+  const ImuInitMonitor* imu_init() const { return imu_init_ ? &*imu_init_ : nullptr; }
+  // The rotation applied to the world (x_gravity = R x_first_camera) and the first frame whose
+  // FrameResult pose is in the turned world; nullopt while not turned.
+  struct GravityAlignment {
+    Eigen::Matrix3d R_new_old = Eigen::Matrix3d::Identity();
+    long from_frame = -1;
+  };
+  const std::optional<GravityAlignment>& gravity_alignment() const { return gravity_alignment_; }
+  // stats.json's "imu": the monitor's report and the world's alignment; null without an IMU.
+  nlohmann::json imu_report() const;
+
   // The trusted frames only (tracking::is_trusted: never a prediction made while lost or before
   // initialisation, nor a pose recovering from an unconfirmed relocalization), T_world_leftcam with
-  // world = the first keyframe's camera.
+  // world = the first keyframe's camera, or its gravity-aligned turn (set_imu()).
   Trajectory tracked_trajectory() const;
   // The id of the first frame that started a map; nullopt while none has.
   std::optional<long> initialized_at() const;
@@ -169,6 +190,10 @@ class System {
   // Deterministic mode: fixes the merge frame of a global BA that started, and merges it there.
   void merge_due_global_ba(long frame_id, double timestamp);
   bool deterministic() const;
+  // Turns the world to the accepted initialisation's gravity-aligned one (set_imu()) if every
+  // other thread is at rest: local mapping and loop closing idle and held paused, no global BA.
+  // `frame_id`: the first frame tracked in the turned world.
+  void align_world_with_gravity(long frame_id);
 
   SystemOptions options_;
   map::Map map_;
@@ -204,6 +229,10 @@ class System {
   WaitStats mapping_waits_;
   WaitStats global_ba_waits_;
   std::vector<long> global_ba_merge_frames_;
+  bool map_loaded_ = false;
+  std::optional<ImuData> imu_data_;  // the monitor refers to it
+  std::optional<ImuInitMonitor> imu_init_;
+  std::optional<GravityAlignment> gravity_alignment_;
 };
 
 }  // namespace plslam::system

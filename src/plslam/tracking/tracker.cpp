@@ -121,6 +121,15 @@ geometry::SE3 Tracker::Anchor::T_cw() const { return keyframe ? T_ck * keyframe-
 
 geometry::SE3 Tracker::pose_of(const FrameRecord& r) { return anchor_of(r).T_cw(); }
 
+void Tracker::transform_world(const geometry::SE3& T_new_old) {
+  const geometry::SE3 T_old_new = T_new_old.inverse();
+  if (last_) last_->T_cw = last_->T_cw * T_old_new;
+  if (recovery_) recovery_->T_cw = recovery_->T_cw * T_old_new;
+  for (FrameRecord& r : records_) {
+    if (!r.reference) r.T_cr = r.T_cr * T_old_new;
+  }
+}
+
 bool Tracker::check_motion(const Frame& f) {
   const auto [m, deg] = pose_gap(f.T_cw, predicted_pose(f));
   motion_deviation_m_.push_back(m);

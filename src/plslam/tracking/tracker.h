@@ -248,6 +248,10 @@ class Tracker {
     std::vector<std::pair<cv::Point2f, cv::Point2f>> lines;
   };
   TrackedFeatures last_tracked_features() const;
+  // The map was re-expressed in another world (map::Map::transform_world): the world poses the
+  // tracker keeps across frames follow it (the last frame, an unconfirmed relocalization, records
+  // without a reference keyframe). Between frames.
+  void transform_world(const geometry::SE3& T_new_old);
   // The pose of a record with every keyframe's current estimate (call with local mapping idle).
   static geometry::SE3 pose_of(const FrameRecord& r);
   // The keyframe a record's pose hangs on (its reference, or the first live ancestor of a culled
