@@ -1,0 +1,156 @@
+#include "plslam/inertial/inertial_pose.h"
+
+#include <Eigen/Cholesky>
+
+#include "plslam/inertial/imu_pose_manifold.h"
+#include "plslam/optim/lm_damping.h"
+#include "plslam/optim/pose_terms.h"
+
+namespace plslam::inertial {
+
+using geometry::Matrix6d;
+using geometry::SE3;
+using geometry::Vector6d;
+
+InertialState predict(const InertialState& i, const Preintegration& i_to_j) {
+  const double dt = i_to_j.dt();
+  const Eigen::Vector3d g = world_gravity();
+  const Eigen::Matrix3d& R_i = i.T_wb.rotation();
+  const Eigen::Vector3d& p_i = i.T_wb.translation();
+  InertialState j;
+  j.T_wb = SE3(Eigen::Quaterniond(R_i * i_to_j.corrected_delta_R(i.bias)).normalized(),
+               p_i + i.v * dt + 0.5 * dt * dt * g + R_i * i_to_j.corrected_delta_p(i.bias));
+  j.v = i.v + g * dt + R_i * i_to_j.corrected_delta_v(i.bias);
+  j.bias = i.bias;
+  return j;
+}
+
+InertialTerms::InertialTerms(const Preintegration& i_to_frame, const InertialState& i, const SE3& T_imu_cam)
+    : imu_(i_to_frame), walk_(i_to_frame), i_(i), T_cam_imu_(T_imu_cam.inverse()),
+      body_from_camera_(-T_imu_cam.adjoint()) {}
+
+Vector15d InertialTerms::evaluate(const SE3& T_cw, const Eigen::Vector3d& v, const ImuBias& bias, Matrix15d* J) const {
+  const ImuPoseParams pose_i = imu_pose_params(i_.T_wb), pose_j = imu_pose_params(body_pose(T_cw));
+  const Vector6d b = bias.vector(), b_i = i_.bias.vector();
+  // The preintegration is corrected for the frame's bias (the ImuCost's bias block).
+  const double* imu_blocks[5] = {pose_i.data(), i_.v.data(), b.data(), pose_j.data(), v.data()};
+  Vector15d r;
+  Eigen::Matrix<double, 9, 6, Eigen::RowMajor> J_bias;
+  Eigen::Matrix<double, 9, 7, Eigen::RowMajor> J_pose;
+  Eigen::Matrix<double, 9, 3, Eigen::RowMajor> J_v;
+  double* imu_jacobians[5] = {nullptr, nullptr, J_bias.data(), J_pose.data(), J_v.data()};
+  imu_.Evaluate(imu_blocks, r.data(), J ? imu_jacobians : nullptr);
+  const double* walk_blocks[2] = {b_i.data(), b.data()};
+  Eigen::Matrix<double, 6, 6, Eigen::RowMajor> J_walk;
+  double* walk_jacobians[2] = {nullptr, J_walk.data()};
+  walk_.Evaluate(walk_blocks, r.data() + 9, J ? walk_jacobians : nullptr);
+  if (J) {
+    J->setZero();
+    // The pose block's Jacobian w.r.t. the body's tangent sits in its first 6 columns (imu_pose_manifold.h).
+    J->block<9, 6>(0, 0) = J_pose.leftCols<6>() * body_from_camera_;
+    J->block<9, 3>(0, 6) = J_v;
+    J->block<9, 6>(0, 9) = J_bias;
+    J->block<6, 6>(9, 9) = J_walk;
+  }
+  return r;
+}
+
+namespace {
+
+struct State {
+  SE3 T_cw;
+  Eigen::Vector3d v;
+  ImuBias bias;
+
+  State plus(const Vector15d& d) const {
+    State s{SE3::exp(d.head<6>()) * T_cw, v + d.segment<3>(6), bias};
+    s.bias.gyro += d.segment<3>(9);
+    s.bias.acc += d.segment<3>(12);
+    return s;
+  }
+};
+
+struct Problem {
+  const optim::PoseTerms& visual;
+  const InertialTerms& imu;
+  const std::vector<bool>& point_out;
+  const std::vector<bool>& line_out;
+
+  // The cost (visual under the kernels when robust, plus the IMU rows'); with H and g, the normal
+  // equations J' W J and J' W r over the 15-dimensional tangent.
+  double evaluate(const State& x, bool robust, Matrix15d* H, Vector15d* g, double* imu_cost = nullptr) const {
+    Matrix6d Hv = Matrix6d::Zero();
+    Vector6d gv = Vector6d::Zero();
+    double cost = visual.evaluate(x.T_cw, point_out, line_out, robust, H ? &Hv : nullptr, H ? &gv : nullptr);
+    Matrix15d J;
+    const Vector15d r = imu.evaluate(x.T_cw, x.v, x.bias, H ? &J : nullptr);
+    if (imu_cost) *imu_cost = r.squaredNorm();
+    cost += r.squaredNorm();
+    if (H) {
+      *H = J.transpose() * J;
+      *g = J.transpose() * r;
+      H->topLeftCorner<6, 6>() += Hv;
+      g->head<6>() += gv;
+    }
+    return cost;
+  }
+};
+
+}  // namespace
+
+InertialPoseResult optimize_pose_inertial(const geometry::StereoCamera& cam, const InertialTerms& imu,
+                                          const SE3& T_cw_init, const Eigen::Vector3d& v_init, const ImuBias& bias_init,
+                                          const std::vector<optim::PosePointTerm>& points,
+                                          const std::vector<optim::PoseLineTerm>& lines,
+                                          const optim::PoseOnlyOptions& options) {
+  const optim::PoseTerms visual(cam, points, lines, options);
+  InertialPoseResult res;
+  auto& flags = res.visual;
+  flags.point_outlier.assign(points.size(), false);
+  flags.line_outlier.assign(lines.size(), false);
+  const Problem p{visual, imu, flags.point_outlier, flags.line_outlier};
+  State x{T_cw_init, v_init, bias_init};
+
+  bool changed = true;
+  for (int round = 0; round < options.rounds; ++round) {
+    const bool robust = round < options.robust_rounds;
+    if (round > 0 && !changed && robust == (round - 1 < options.robust_rounds)) continue;
+    Matrix15d H;
+    Vector15d g;
+    double cost = p.evaluate(x, robust, &H, &g);
+    optim::LmDamping damping;
+    for (int it = 0; it < options.iterations_per_round; ++it) {
+      ++flags.iterations;
+      Matrix15d A = H;
+      A.diagonal() += damping.lambda * H.diagonal() + Vector15d::Constant(1e-12 * H.diagonal().maxCoeff());
+      const Vector15d d = A.ldlt().solve(-g);
+      if (!d.allFinite()) break;
+      const State x_new = x.plus(d);
+      Matrix15d H_new;
+      Vector15d g_new;
+      const double new_cost = p.evaluate(x_new, robust, &H_new, &g_new);
+      if (new_cost < cost) {
+        const double old_cost = cost;
+        x = x_new;
+        cost = new_cost;
+        H = H_new;
+        g = g_new;
+        if (damping.accepted(d.squaredNorm(), old_cost, new_cost)) break;
+      } else if (damping.rejected(d.squaredNorm())) {
+        break;
+      }
+    }
+    const std::vector<bool> prev_points = flags.point_outlier, prev_lines = flags.line_outlier;
+    flags.final_cost = visual.classify(x.T_cw, &flags.point_outlier, &flags.line_outlier);
+    changed = prev_points != flags.point_outlier || prev_lines != flags.line_outlier;
+  }
+  Vector15d g;
+  p.evaluate(x, /*robust=*/false, &res.information, &g, &res.imu_cost);
+  flags.T_cw = x.T_cw;
+  for (const bool o : flags.point_outlier) flags.num_point_inliers += o ? 0 : 1;
+  for (const bool o : flags.line_outlier) flags.num_line_inliers += o ? 0 : 1;
+  res.state = {imu.body_pose(x.T_cw), x.v, x.bias};
+  return res;
+}
+
+}  // namespace plslam::inertial
