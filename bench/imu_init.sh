@@ -3,7 +3,9 @@
 # office at EuRoC's rate with EuRoC's IMU noise and non-zero biases, run by `plslam run`, whose
 # stats.json "imu" holds the initialisation (or the last refused attempt). Compared with the truth:
 # gravity in the first camera's frame (the run's world) from synth/left_camera.tum, and the gyro
-# bias at the initialisation's time from state_groundtruth_estimate0.
+# bias at the initialisation's time from state_groundtruth_estimate0. Once accepted, the run's
+# world turns to the gravity-aligned one: the worst tilt error of trajectory.tum's poses against
+# the truth's (z up) says how level every output is.
 #
 #   bench/imu_init.sh [--plslam PATH] [--seeds "1 2 3 4 5"] [--motions "walk handheld drone"]
 #                     [--frames N] OUT
@@ -60,7 +62,16 @@ state = f"accepted after {init['seconds_of_motion']:.2f} s" if init["accepted"] 
 print(f"{motion:8s} seed {seed}: {state}; gravity error {g_err:.3f} deg (sigma {init['gravity_sigma_deg']:.3f}) "
       f"{'ok' if ok_g else 'OVER'}; gyro bias error {bg_err:.2e} of {np.linalg.norm(bg_true):.2e} "
       f"{'ok' if ok_bg else 'OVER'}; acc bias {np.round(init['acc_bias'], 3).tolist()} (true {np.round(ba_true, 3).tolist()}); "
-      f"rotation {init['rotation_deg']:.0f} deg")
+      f"rotation {init['rotation_deg']:.0f} deg", end="")
+world = imu.get("world", {})
+if world.get("gravity_aligned"):
+    truth = {round(r[0], 3): q2R(*r[4:8]) for r in np.loadtxt(seq + "/mav0/synth/left_camera.tum")}
+    worst = 0.0
+    for r in np.loadtxt(stats.replace("stats.json", "trajectory.tum")):
+        down, down_true = q2R(*r[4:8]).T @ [0, 0, -1.0], truth[round(r[0], 3)].T @ [0, 0, -1.0]
+        worst = max(worst, math.degrees(math.atan2(np.linalg.norm(np.cross(down, down_true)), down @ down_true)))
+    print(f"; world z up from frame {world['from_frame']}, trajectory tilt error <= {worst:.3f} deg", end="")
+print()
 PY
     tail -1 "$table"
   done

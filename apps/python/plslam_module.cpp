@@ -215,9 +215,19 @@ PYBIND11_MODULE(plslam, m) {
              d["keyframes"] = st.keyframes;
              d["points"] = st.points;
              d["lines"] = st.lines;
+             d["gravity_aligned"] = st.gravity_aligned;
              return d;
            })
       .def_property_readonly("calibration", &Slam::calibration)
+      .def(
+          "use_imu",
+          [](Slam& s, const PyDataset& d) {
+            if (!d.dataset().imu()) throw py::value_error("use_imu: the dataset has no IMU (mav0/imu0)");
+            s.use_imu(*d.dataset().imu());
+          },
+          py::arg("dataset"),
+          "Before the first track(): the dataset's IMU, as plslam run uses it (visual-inertial "
+          "initialisation, then a gravity-aligned world)")
       .def("load_map", &Slam::load_map, py::arg("path"), py::call_guard<py::gil_scoped_release>())
       .def("save_map", &Slam::save_map, py::arg("path"), py::call_guard<py::gil_scoped_release>())
       .def("shutdown", &Slam::shutdown, py::call_guard<py::gil_scoped_release>())
@@ -235,6 +245,7 @@ PYBIND11_MODULE(plslam, m) {
       .def("__getitem__", &PyDataset::get)
       .def_property_readonly("calibration", [](const PyDataset& d) { return d.dataset().calibration(); })
       .def_property_readonly("timestamps", [](const PyDataset& d) { return d.dataset().timestamps(); })
+      .def_property_readonly("has_imu", [](const PyDataset& d) { return d.dataset().imu().has_value(); })
       .def_property_readonly("preset", [](const PyDataset& d) {
         return d.dataset().format() == io::DatasetFormat::kKitti ? "kitti" : "euroc";
       })

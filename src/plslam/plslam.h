@@ -21,6 +21,7 @@
 #include <opencv2/core.hpp>
 
 #include "plslam/core/error.h"  // InputError: bad input, one line naming the file
+#include "plslam/core/imu.h"    // ImuData
 #include "plslam/core/types.h"  // StereoCalibration, StampedPose, Trajectory
 
 namespace plslam {
@@ -110,6 +111,9 @@ struct SlamStats {
   long relocalizations = 0;
   long loops = 0;            // loops closed
   std::size_t keyframes = 0, points = 0, lines = 0;  // in the map now
+  // With use_imu(): the visual-inertial initialisation was accepted and the world turned to the
+  // gravity-aligned one (z up; poses from then on, and trajectory() and map() wholly, are in it).
+  bool gravity_aligned = false;
 };
 
 // A recorded sequence in the EuRoC/ASL or KITTI odometry layout, as `plslam run` reads it:
@@ -134,6 +138,8 @@ class Sequence {
   StereoImages frame(std::size_t i) const;
   // T_world_camera of the left camera; null when the sequence has none.
   const Trajectory* ground_truth() const;
+  // The IMU (EuRoC's mav0/imu0), cut to the frames +-0.5 s; null when the sequence has none.
+  const ImuData* imu() const;
 
  private:
   struct Impl;
@@ -175,6 +181,12 @@ class Slam {
   SlamStats stats() const;
   const StereoCalibration& calibration() const;
 
+  // Before the first track(): the IMU of the sequence (a copy). As `plslam run` with an IMU: the
+  // visual-inertial initialisation runs on the tracked frames and, once accepted, the world turns
+  // to the gravity-aligned one (README, "The world frame, with and without an IMU"); tracking does
+  // not use the IMU otherwise yet. Ignored with localization_only. std::logic_error after the
+  // first track().
+  void use_imu(const ImuData& imu);
   // Before the first track(): continues (or, with localization_only, localizes in) a map saved by
   // save_map() or `plslam run --save-map`. InputError when the file is bad or was made with another
   // calibration or vocabulary.

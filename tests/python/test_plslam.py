@@ -153,9 +153,12 @@ def test_deterministic_tracking_is_reproducible_and_with_a_one_frame_lag_sequent
 
 
 def test_office_loop_poses_equal_the_cli_sequential_run(office_loop, tmp_path):
-    """Python tracking of the office loop gives the CLI's poses (both --sequential)."""
+    """Python tracking of the office loop gives the CLI's poses (both --sequential, both with the
+    render's IMU: the world turns gravity-aligned once it is initialised)."""
     ds = plslam.Dataset(str(office_loop))
+    assert ds.has_imu
     with plslam.System(ds.calibration, preset=ds.preset, sequential=True) as slam:
+        slam.use_imu(ds)
         for i in range(len(ds)):
             t, left, right = ds[i]
             slam.track(left, right, t)
@@ -164,6 +167,7 @@ def test_office_loop_poses_equal_the_cli_sequential_run(office_loop, tmp_path):
     assert stats["frames"] == len(ds) == 480
     assert stats["tracked"] == 480
     assert stats["loops"] >= 1
+    assert stats["gravity_aligned"]
 
     out = tmp_path / "cli"
     subprocess.run([CLI, "run", str(office_loop), "--out", str(out), "--sequential", "--quiet"], check=True,

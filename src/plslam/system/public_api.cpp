@@ -120,6 +120,11 @@ StereoImages Sequence::frame(std::size_t i) const {
   auto f = impl_->dataset->load(i);
   return {f.timestamp, std::move(f.left), std::move(f.right)};
 }
+const ImuData* Sequence::imu() const {
+  const auto& imu = impl_->dataset->imu();
+  return imu ? &*imu : nullptr;
+}
+
 const Trajectory* Sequence::ground_truth() const {
   const auto& gt = impl_->dataset->ground_truth();
   return gt ? &*gt : nullptr;
@@ -239,10 +244,16 @@ SlamStats Slam::stats() const {
   s.keyframes = sys.map().num_keyframes();
   s.points = sys.map().num_points();
   s.lines = sys.map().num_lines();
+  s.gravity_aligned = sys.gravity_alignment().has_value();
   return s;
 }
 
 const StereoCalibration& Slam::calibration() const { return impl_->calib; }
+
+void Slam::use_imu(const ImuData& imu) {
+  if (impl_->frames > 0 || impl_->shut_down) throw std::logic_error("plslam::Slam::use_imu: call it before the first track()");
+  impl_->slam->set_imu(imu);
+}
 
 void Slam::load_map(const std::filesystem::path& file) {
   auto& d = *impl_;
