@@ -1,9 +1,7 @@
 #include "plslam/inertial/inertial_pose.h"
 
-#include <Eigen/Cholesky>
-
 #include "plslam/inertial/imu_pose_manifold.h"
-#include "plslam/optim/lm_damping.h"
+#include "plslam/optim/pose_rounds.h"
 #include "plslam/optim/pose_terms.h"
 
 namespace plslam::inertial {
@@ -105,50 +103,14 @@ InertialPoseResult optimize_pose_inertial(const geometry::StereoCamera& cam, con
                                           const optim::PoseOnlyOptions& options) {
   const optim::PoseTerms visual(cam, points, lines, options);
   InertialPoseResult res;
-  auto& flags = res.visual;
-  flags.point_outlier.assign(points.size(), false);
-  flags.line_outlier.assign(lines.size(), false);
-  const Problem p{visual, imu, flags.point_outlier, flags.line_outlier};
-  State x{T_cw_init, v_init, bias_init};
-
-  bool changed = true;
-  for (int round = 0; round < options.rounds; ++round) {
-    const bool robust = round < options.robust_rounds;
-    if (round > 0 && !changed && robust == (round - 1 < options.robust_rounds)) continue;
-    Matrix15d H;
-    Vector15d g;
-    double cost = p.evaluate(x, robust, &H, &g);
-    optim::LmDamping damping;
-    for (int it = 0; it < options.iterations_per_round; ++it) {
-      ++flags.iterations;
-      Matrix15d A = H;
-      A.diagonal() += damping.lambda * H.diagonal() + Vector15d::Constant(1e-12 * H.diagonal().maxCoeff());
-      const Vector15d d = A.ldlt().solve(-g);
-      if (!d.allFinite()) break;
-      const State x_new = x.plus(d);
-      Matrix15d H_new;
-      Vector15d g_new;
-      const double new_cost = p.evaluate(x_new, robust, &H_new, &g_new);
-      if (new_cost < cost) {
-        const double old_cost = cost;
-        x = x_new;
-        cost = new_cost;
-        H = H_new;
-        g = g_new;
-        if (damping.accepted(d.squaredNorm(), old_cost, new_cost)) break;
-      } else if (damping.rejected(d.squaredNorm())) {
-        break;
-      }
-    }
-    const std::vector<bool> prev_points = flags.point_outlier, prev_lines = flags.line_outlier;
-    flags.final_cost = visual.classify(x.T_cw, &flags.point_outlier, &flags.line_outlier);
-    changed = prev_points != flags.point_outlier || prev_lines != flags.line_outlier;
-  }
+  const Problem p{visual, imu, res.visual.point_outlier, res.visual.line_outlier};
+  const State x = optim::run_pose_rounds<15>(
+      visual, options, State{T_cw_init, v_init, bias_init}, res.visual,
+      [&](const State& s, bool robust, Matrix15d* H, Vector15d* g) { return p.evaluate(s, robust, H, g); },
+      [](const State& s, const Vector15d& d) { return s.plus(d); }, [](const State& s) { return s.T_cw; });
   Vector15d g;
   p.evaluate(x, /*robust=*/false, &res.information, &g, &res.imu_cost);
-  flags.T_cw = x.T_cw;
-  for (const bool o : flags.point_outlier) flags.num_point_inliers += o ? 0 : 1;
-  for (const bool o : flags.line_outlier) flags.num_line_inliers += o ? 0 : 1;
+  res.visual.T_cw = x.T_cw;
   res.state = {imu.body_pose(x.T_cw), x.v, x.bias};
   return res;
 }
