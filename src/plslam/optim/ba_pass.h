@@ -18,6 +18,7 @@ struct BaState {
   std::vector<geometry::SE3> poses;                 // T_cw per keyframe
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Matrix<double, 6, 1>> lines;  // [start; end]
+  std::vector<Vector9d> extra;                      // per keyframe, with keyframe factors
 };
 
 // Observations left out of a pass (indexed like the problem's observation arrays).

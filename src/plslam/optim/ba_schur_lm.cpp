@@ -13,6 +13,9 @@
 // 6x6 line blocks invertible although their endpoints can slide along the 3D line (each block has
 // a 2-D null space; the gradient has no component there, so the damped step stays put).
 // Pose update on the left, T <- exp(dc) T, as the residual Jacobians assume.
+// Keyframe factors (ba_keyframe_factor.h: the IMU's) tie keyframes with no landmark between them:
+// their normal equations go straight into the reduced system, which then also holds the free
+// keyframes' extra states (9 each) after the 6 n_cams pose unknowns.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -421,13 +424,17 @@ class SchurLm {
   template <class Body>
   Accumulator accumulate(int n, const Body& body) const;
 
-  // Linearises at `poses` and the landmarks (plus their step when with_step) into the *_next
-  // buffers; returns 2x the cost, infinity when an observation is behind its camera.
-  double linearize(const std::vector<SE3>& poses, bool with_step);
+  // Linearises at `poses`, `extra` and the landmarks (plus their step when with_step) into the
+  // *_next buffers; returns 2x the cost, infinity when an observation is behind its camera.
+  double linearize(const std::vector<SE3>& poses, const std::vector<Vector9d>& extra, bool with_step);
+  // The keyframe factors' share of the reduced system, added to C_next_ and gc_next_ (grown to
+  // take the extra states); returns their sum of squared residuals.
+  double linearize_keyframe_factors(const std::vector<SE3>& poses, const std::vector<Vector9d>& extra);
+  Eigen::Index pose_unknowns() const { return 6 * static_cast<Eigen::Index>(kf_of_cam_.size()); }
   void swap_in_next();
   bool solve(double lambda);
   double model_decrease(double lambda) const;
-  void apply(std::vector<SE3> poses);
+  void apply(std::vector<SE3> poses, std::vector<Vector9d> extra);
   double state_norm() const;
   double step_norm() const;
   BaExclusions exclusions_with_invalid() const;
@@ -454,6 +461,8 @@ class SchurLm {
 
   std::vector<int> cam_of_kf_;
   std::vector<int> kf_of_cam_;
+  std::vector<int> extra_of_kf_;  // extra-state slot of a free keyframe in a keyframe factor, else -1
+  std::vector<int> kf_of_extra_;
   Groups<PointKind> points_;
   Groups<LineKind> lines_;
   std::vector<Eigen::Matrix3d> line_along_;  // per line slot: d d' of its direction (zero: collapsed)
@@ -478,6 +487,18 @@ void SchurLm::build(const BaExclusions* excluded) {
   }
   for (std::size_t k = 0; k < p_.line_observations.size(); ++k) {
     if (!excluded || !excluded->line_out[k]) mark(p_.line_observations[k].keyframe);
+  }
+  // After the observed ones, so that a problem without factors keeps its slots.
+  extra_of_kf_.assign(p_.keyframes.size(), -1);
+  kf_of_extra_.clear();
+  for (const auto& f : p_.keyframe_factors) {
+    for (const int kf : f->keyframes()) {
+      mark(kf);
+      const auto k = static_cast<std::size_t>(kf);
+      if (p_.keyframes[k].fixed || extra_of_kf_[k] >= 0) continue;
+      extra_of_kf_[k] = static_cast<int>(kf_of_extra_.size());
+      kf_of_extra_.push_back(kf);
+    }
   }
   points_ = make_groups<PointKind>(p_, opt_, PointKind::excluded(excluded), cam_of_kf_);
   lines_ = make_groups<LineKind>(p_, opt_, LineKind::excluded(excluded), cam_of_kf_);
@@ -599,7 +620,53 @@ void SchurLm::linearize_fixed(const Groups<Kind>& G, int k, const std::vector<SE
   }
 }
 
-double SchurLm::linearize(const std::vector<SE3>& poses, bool with_step) {
+double SchurLm::linearize_keyframe_factors(const std::vector<SE3>& poses, const std::vector<Vector9d>& extra) {
+  const Eigen::Index n6 = pose_unknowns();
+  const Eigen::Index n = n6 + 9 * static_cast<Eigen::Index>(kf_of_extra_.size());
+  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(n, n);
+  C.topLeftCorner(n6, n6) = C_next_;
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+  g.head(n6) = gc_next_;
+  double sq = 0.0;
+  std::vector<SE3> T;
+  std::vector<Vector9d> x;
+  std::vector<Eigen::Index> at;  // per factor column block: its row in the reduced system, -1 fixed
+  Eigen::MatrixXd J;
+  for (const auto& f : p_.keyframe_factors) {
+    const auto kfs = f->keyframes();
+    T.clear();
+    x.clear();
+    at.clear();
+    for (const int kf : kfs) {
+      const auto k = static_cast<std::size_t>(kf);
+      T.push_back(poses[k]);
+      x.push_back(extra[k]);
+      // Pose columns, then the extra state's (a factor's keyframe with a camera slot has one).
+      const int c = cam_of_kf_[k];
+      at.push_back(c >= 0 ? 6 * static_cast<Eigen::Index>(c) : -1);
+      at.push_back(c >= 0 ? n6 + 9 * static_cast<Eigen::Index>(extra_of_kf_[k]) : -1);
+    }
+    const Eigen::VectorXd r = f->evaluate(T, x, &J);
+    if (!r.allFinite() || !J.allFinite()) return std::numeric_limits<double>::infinity();
+    sq += r.squaredNorm();
+    const auto width = [](std::size_t b) { return b % 2 == 0 ? 6 : 9; };
+    const auto col = [](std::size_t b) { return static_cast<Eigen::Index>(15 * (b / 2) + (b % 2 == 0 ? 0 : 6)); };
+    for (std::size_t a = 0; a < at.size(); ++a) {
+      if (at[a] < 0) continue;
+      const auto Ja = J.middleCols(col(a), width(a));
+      g.segment(at[a], width(a)).noalias() += Ja.transpose() * r;
+      for (std::size_t b = 0; b < at.size(); ++b) {
+        if (at[b] < 0) continue;
+        C.block(at[a], at[b], width(a), width(b)).noalias() += Ja.transpose() * J.middleCols(col(b), width(b));
+      }
+    }
+  }
+  C_next_ = std::move(C);
+  gc_next_ = std::move(g);
+  return sq;
+}
+
+double SchurLm::linearize(const std::vector<SE3>& poses, const std::vector<Vector9d>& extra, bool with_step) {
   Accumulator acc = accumulate(work_items(), [&](int item, Accumulator& a) {
     dispatch(
         item, points_, lines_, [&](auto& G, int i) { linearize_slot(G, i, poses, with_step, a); },
@@ -607,7 +674,9 @@ double SchurLm::linearize(const std::vector<SE3>& poses, bool with_step) {
   });
   C_next_ = std::move(acc.H);
   gc_next_ = std::move(acc.g);
-  return acc.failures > 0 ? std::numeric_limits<double>::infinity() : acc.rho;
+  if (acc.failures > 0) return std::numeric_limits<double>::infinity();
+  if (p_.keyframe_factors.empty()) return acc.rho;
+  return acc.rho + linearize_keyframe_factors(poses, extra);
 }
 
 void SchurLm::swap_in_next() {
@@ -685,11 +754,20 @@ bool SchurLm::solve(double lambda) {
     // than LDLT: Eigen's LLT is blocked (matrix-matrix updates), its LDLT is rank-1 updates only,
     // which made the factorisation a third of a 150-keyframe global BA's CPU. The damped system is
     // positive definite; when it is not, the step fails and LM damps more, as for a landmark.
-    Eigen::MatrixXd S = C_ + acc.H;
+    // (The landmarks touch only the pose unknowns, the first 6 n_cams.)
+    const bool extra = n > acc.H.rows();
+    Eigen::MatrixXd S = extra ? C_ : C_ + acc.H;
+    if (extra) S.topLeftCorner(acc.H.rows(), acc.H.cols()) += acc.H;
     for (Eigen::Index j = 0; j < n; ++j) S(j, j) += lambda * damping_diagonal(C_(j, j));
     const Eigen::LLT<Eigen::MatrixXd, Eigen::Upper> llt(S);
     if (llt.info() != Eigen::Success) return false;
-    dc_ = llt.solve(-(gc_ + acc.g));
+    if (extra) {
+      Eigen::VectorXd rhs = -gc_;
+      rhs.head(acc.g.size()) -= acc.g;
+      dc_ = llt.solve(rhs);
+    } else {
+      dc_ = llt.solve(-(gc_ + acc.g));
+    }
     if (!dc_.allFinite()) return false;
   } else {
     dc_.resize(0);
@@ -726,8 +804,9 @@ double SchurLm::model_decrease(double lambda) const {
   return 0.5 * sum;
 }
 
-void SchurLm::apply(std::vector<SE3> poses) {
+void SchurLm::apply(std::vector<SE3> poses, std::vector<Vector9d> extra) {
   s_->poses = std::move(poses);
+  s_->extra = std::move(extra);
   const auto add = [&](auto& G, auto& values) {
     for (std::size_t i = 0; i < G.dx.size(); ++i) {
       values[static_cast<std::size_t>(G.landmark[i])] += G.dx[i];
@@ -742,6 +821,7 @@ double SchurLm::state_norm() const {
   for (const int kf : kf_of_cam_) {
     sq += s_->poses[static_cast<std::size_t>(kf)].translation().squaredNorm() + 1.0;  // + |q|^2
   }
+  for (const int kf : kf_of_extra_) sq += s_->extra[static_cast<std::size_t>(kf)].squaredNorm();
   for (const int l : points_.landmark) sq += s_->points[static_cast<std::size_t>(l)].squaredNorm();
   for (const int l : lines_.landmark) sq += s_->lines[static_cast<std::size_t>(l)].squaredNorm();
   return std::sqrt(sq);
@@ -778,7 +858,7 @@ BaExclusions SchurLm::exclusions_with_invalid() const {
 BaPassSummary SchurLm::run() {
   BaPassSummary out;
   int dropped = 0;
-  rho_ = linearize(s_->poses, false);
+  rho_ = linearize(s_->poses, s_->extra, false);
   if (!std::isfinite(rho_)) {
     // Observations behind their camera at the start are left out of this pass (Ceres would
     // refuse to start); the final gate flags them as outliers.
@@ -786,11 +866,12 @@ BaPassSummary SchurLm::run() {
     for (const bool b : ex.point_out) dropped += b;
     for (const bool b : ex.line_out) dropped += b;
     build(&ex);
-    rho_ = linearize(s_->poses, false);
+    rho_ = linearize(s_->poses, s_->extra, false);
   }
   swap_in_next();
   out.initial_cost = out.final_cost = 0.5 * rho_;
-  if (points_.refs.empty() && lines_.refs.empty() && points_.fixed.empty() && lines_.fixed.empty()) {
+  if (points_.refs.empty() && lines_.refs.empty() && points_.fixed.empty() && lines_.fixed.empty() &&
+      p_.keyframe_factors.empty()) {
     out.message = "no observations";  // not usable: nothing was optimised
     return out;
   }
@@ -832,13 +913,17 @@ BaPassSummary SchurLm::run() {
       auto& T = poses[static_cast<std::size_t>(kf_of_cam_[c])];
       T = SE3::exp(dc_.segment<6>(6 * static_cast<Eigen::Index>(c))) * T;
     }
-    const double rho_new = linearize(poses, true);  // the next linearisation if accepted
+    std::vector<Vector9d> extra = s_->extra;
+    for (std::size_t e = 0; e < kf_of_extra_.size(); ++e) {
+      extra[static_cast<std::size_t>(kf_of_extra_[e])] += dc_.segment<9>(pose_unknowns() + 9 * static_cast<Eigen::Index>(e));
+    }
+    const double rho_new = linearize(poses, extra, true);  // the next linearisation if accepted
     const double decrease = 0.5 * (rho_ - rho_new);
     const double model = model_decrease(lambda);
     const double ratio = decrease / model;
     const bool converged = std::isfinite(rho_new) && std::abs(decrease) <= opt_.function_tolerance * 0.5 * rho_;
     if (std::isfinite(rho_new) && model > 0.0 && ratio > kMinRelativeDecrease) {
-      apply(std::move(poses));
+      apply(std::move(poses), std::move(extra));
       swap_in_next();
       rho_ = rho_new;
       ++accepted;
@@ -862,9 +947,10 @@ BaPassSummary SchurLm::run() {
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "Schur LM: %d iterations (%d accepted), cost %.6e -> %.6e, lambda %.1e, %s; "
-                "%d cameras, %d points, %d lines, %d observations dropped behind a camera",
+                "%d cameras, %d points, %d lines, %d observations dropped behind a camera%s",
                 out.iterations, accepted, out.initial_cost, out.final_cost, lambda, why,
-                static_cast<int>(kf_of_cam_.size()), points_.slots(), lines_.slots(), dropped);
+                static_cast<int>(kf_of_cam_.size()), points_.slots(), lines_.slots(), dropped,
+                p_.keyframe_factors.empty() ? "" : (", " + std::to_string(p_.keyframe_factors.size()) + " keyframe factors").c_str());
   out.message = buf;
   return out;
 }

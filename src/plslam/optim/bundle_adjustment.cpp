@@ -1,5 +1,6 @@
 #include "plslam/optim/bundle_adjustment.h"
 
+#include <stdexcept>
 #include <string>
 
 #include "plslam/core/error.h"
@@ -24,6 +25,19 @@ void check_indices(const BaProblem& p) {
     if (bad(o.keyframe, p.keyframes.size()) || bad(o.line, p.lines.size())) {
       throw InputError("", "bundle_adjust: line observation index out of range (keyframe " +
                                std::to_string(o.keyframe) + ", line " + std::to_string(o.line) + ")");
+    }
+  }
+  if (p.keyframe_factors.empty()) return;
+  if (p.keyframe_extra.size() != p.keyframes.size()) {
+    throw InputError("", "bundle_adjust: keyframe factors need one extra state per keyframe (" +
+                             std::to_string(p.keyframe_extra.size()) + " for " + std::to_string(p.keyframes.size()) +
+                             " keyframes)");
+  }
+  for (const auto& f : p.keyframe_factors) {
+    for (const int k : f->keyframes()) {
+      if (bad(k, p.keyframes.size())) {
+        throw InputError("", "bundle_adjust: keyframe factor index out of range (keyframe " + std::to_string(k) + ")");
+      }
     }
   }
 }
@@ -68,11 +82,14 @@ BaPassSummary run_pass(const geometry::StereoCamera& cam, const BaProblem& p,
   if (opt.backend == BaBackend::kSchurLM) {
     int free_keyframes = 0;
     for (const auto& kf : p.keyframes) free_keyframes += kf.fixed ? 0 : 1;
-    if (free_keyframes <= opt.max_dense_keyframes) return schur_lm_ba_pass(cam, p, opt, spec, s);
+    if (free_keyframes <= opt.max_dense_keyframes || !p.keyframe_factors.empty()) {
+      return schur_lm_ba_pass(cam, p, opt, spec, s);
+    }
     BaOptions sparse = opt;
     sparse.linear_solver = BaLinearSolver::kSparseSchur;
     return ceres_ba_pass(cam, p, sparse, spec, s);
   }
+  if (!p.keyframe_factors.empty()) throw std::invalid_argument("bundle_adjust: the Ceres backend takes no keyframe factors");
   return ceres_ba_pass(cam, p, opt, spec, s);
 }
 
@@ -91,6 +108,7 @@ BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& p,
     s.lines.emplace_back();
     s.lines.back() << l.start, l.end;
   }
+  if (!p.keyframe_factors.empty()) s.extra = p.keyframe_extra;
 
   BaResult res;
   const auto first = run_pass(cam, p, opt, {opt.robust, opt.iterations, nullptr}, &s);
@@ -114,6 +132,11 @@ BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& p,
   res.line_observation_outlier = std::move(final_gates.line_out);
   for (std::size_t k = 0; k < p.keyframes.size(); ++k) {
     res.poses.push_back(p.keyframes[k].fixed ? p.keyframes[k].T_cw : s.poses[k]);
+  }
+  if (!p.keyframe_factors.empty()) {
+    for (std::size_t k = 0; k < p.keyframes.size(); ++k) {
+      res.keyframe_extra.push_back(p.keyframes[k].fixed ? p.keyframe_extra[k] : s.extra[k]);
+    }
   }
   res.points = std::move(s.points);
   for (const auto& l : s.lines) res.lines.push_back({l.head<3>(), l.tail<3>()});

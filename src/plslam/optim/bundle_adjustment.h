@@ -7,6 +7,7 @@
 // poses T_cw with fixed flags, landmarks, and observations indexing them. A local BA is this
 // problem restricted to a window, with the covisible keyframes outside it marked fixed.
 #include <atomic>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "plslam/geometry/se3.h"
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/geometry/triangulation.h"
+#include "plslam/optim/ba_keyframe_factor.h"
 #include "plslam/optim/observations.h"
 #include "plslam/optim/robust.h"
 
@@ -44,6 +46,12 @@ struct BaProblem {
   std::vector<BaLine> lines;
   std::vector<StereoPointObservation> point_observations;
   std::vector<StereoLineObservation> line_observations;
+  // Factors between keyframes (ba_keyframe_factor.h: the IMU's, in a visual-inertial BA) and, with
+  // them, one extra state per keyframe, which moves with its keyframe's pose and is held with it.
+  // The Schur backend only: a problem with factors stays there whatever its size, and the Ceres
+  // backend refuses it (std::invalid_argument).
+  std::vector<Vector9d> keyframe_extra;
+  std::vector<std::shared_ptr<const BaKeyframeFactor>> keyframe_factors;
 };
 
 enum class BaLinearSolver { kDenseSchur, kSparseSchur };  // Ceres backend only
@@ -82,6 +90,7 @@ struct BaResult {
   std::vector<geometry::SE3> poses;            // one per keyframe (fixed ones unchanged)
   std::vector<Eigen::Vector3d> points;         // one per point
   std::vector<geometry::Segment3d> lines;      // one per line
+  std::vector<Vector9d> keyframe_extra;        // as the problem's (fixed ones unchanged)
   std::vector<bool> point_observation_outlier;  // per observation, gated at the final state
   std::vector<bool> line_observation_outlier;
   double initial_cost = 0.0;  // cost (1/2 sum rho, Ceres' definition) at the start of pass 1
@@ -92,7 +101,8 @@ struct BaResult {
   std::string message;  // the solver's brief report of the last pass (for logs)
 };
 
-// Throws InputError when an observation indexes outside the problem's arrays.
+// Throws InputError when an observation or a keyframe factor indexes outside the problem's arrays,
+// or when there are factors and not one extra state per keyframe.
 // An observation whose landmark is behind its camera at the start of a pass makes the Ceres
 // backend fail (usable = false); kSchurLM leaves it out of that pass instead. Either way it is
 // flagged as an outlier in the result.
