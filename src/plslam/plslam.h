@@ -68,7 +68,9 @@ const char* to_string(TrackingState state);
 // "localized" (in a loaded map, localization only) are poses plslam stands behind; "recovering"
 // (tracked from a relocalization not yet confirmed), "unanchored" (tracked in a new map segment
 // that no loop has tied to the map: its place in the world is a guess) and "lost" are not.
-enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized, kUnanchored };
+// "inertial": vision could not track the frame (no texture) and the IMU carried its pose for a
+// few seconds at most (Slam::use_imu): trusted.
+enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized, kUnanchored, kInertial };
 const char* to_string(FrameState state);
 
 struct TrackedFrame {
@@ -76,7 +78,7 @@ struct TrackedFrame {
   double timestamp = 0;    // seconds, as given
   TrackingState state = TrackingState::kNotInitialized;
   FrameState frame_state = FrameState::kLost;
-  // T_world_camera is a trusted estimate (frame_state tracked, relocalized or localized).
+  // T_world_camera is a trusted estimate (frame_state tracked, relocalized, localized or inertial).
   bool tracked = false;
   // The left camera in the world (maps camera coordinates to world coordinates); the world is the
   // first keyframe's camera, or the loaded map's world.

@@ -463,3 +463,89 @@ TEST(MapLine, RefitRecoversDirectionAndExtentFromTheObservations) {
 
 }  // namespace
 }  // namespace plslam::map
+
+namespace plslam::map {
+namespace {
+
+// IMU samples of a body turning at a steady rate and accelerating, 200 Hz over [0, 1] s.
+std::vector<ImuSample> turning_samples() {
+  std::vector<ImuSample> s;
+  for (int k = 0; k <= 200; ++k) {
+    const double t = 0.005 * k;
+    s.push_back({t, Eigen::Vector3d(0.3, -0.2 + t, 0.5), Eigen::Vector3d(1.0 + t, 0.2, 9.81 - 0.5 * t)});
+  }
+  return s;
+}
+
+std::shared_ptr<FrameData> data_at(long id, double t) {
+  auto d = std::make_shared<FrameData>();
+  d->frame_id = id;
+  d->timestamp = t;
+  return d;
+}
+
+// A culled keyframe of the IMU chain hands its interval to its successor: the successor's
+// preintegration then runs from the culled one's predecessor, as if integrated over the whole
+// interval at once; a culled first keyframe of the chain leaves its successor at the chain's start.
+TEST(KeyFrameImu, CullingJoinsTheNeighboursIntervals) {
+  Map map;
+  map.create_keyframe(data_at(0, 0.0), geometry::SE3());  // the origin, never culled
+  KeyFrame* k[4];
+  const double t[4] = {0.1, 0.3, 0.45, 0.6};
+  for (int i = 0; i < 4; ++i) k[i] = map.create_keyframe(data_at(i + 1, t[i]), geometry::SE3());
+  const auto samples = turning_samples();
+  const inertial::ImuBias b0{Eigen::Vector3d(0.01, 0, -0.02), Eigen::Vector3d(0.1, -0.05, 0)};
+  const inertial::ImuBias b1{Eigen::Vector3d(0.02, 0.01, 0), Eigen::Vector3d(0, 0.05, 0.1)};
+  auto between = [&](int i, int j, const inertial::ImuBias& b) {
+    return std::make_shared<const inertial::Preintegration>(samples, t[i], t[j], b, kEurocAdis16448Noise);
+  };
+  k[0]->set_imu({Eigen::Vector3d(1, 0, 0), b0, nullptr, nullptr});
+  k[1]->set_imu({Eigen::Vector3d(1, 0.1, 0), b1, k[0], between(0, 1, b0)});
+  k[2]->set_imu({Eigen::Vector3d(1, 0.2, 0), b1, k[1], between(1, 2, b1)});
+  k[3]->set_imu({Eigen::Vector3d(1, 0.3, 0), b1, k[2], between(2, 3, b1)});
+  EXPECT_EQ(k[0]->imu_next(), k[1]);
+  EXPECT_EQ(k[2]->imu_next(), k[3]);
+  EXPECT_EQ(k[3]->imu_next(), nullptr);
+
+  k[1]->set_bad();
+  EXPECT_EQ(k[0]->imu_next(), k[2]);
+  const auto s2 = k[2]->imu();
+  ASSERT_TRUE(s2);
+  EXPECT_EQ(s2->previous, k[0]);
+  ASSERT_TRUE(s2->from_previous);
+  // Integrated again at the predecessor's bias, over both intervals.
+  const inertial::Preintegration direct(samples, t[0], t[2], b0, kEurocAdis16448Noise);
+  EXPECT_DOUBLE_EQ(s2->from_previous->t_i(), t[0]);
+  EXPECT_DOUBLE_EQ(s2->from_previous->t_j(), t[2]);
+  EXPECT_LT((s2->from_previous->delta_R() - direct.delta_R()).norm(), 1e-12);
+  EXPECT_LT((s2->from_previous->delta_v() - direct.delta_v()).norm(), 1e-12);
+  EXPECT_LT((s2->from_previous->delta_p() - direct.delta_p()).norm(), 1e-12);
+  EXPECT_LT((s2->from_previous->covariance() - direct.covariance()).norm(), 1e-12 * direct.covariance().norm());
+  EXPECT_EQ(s2->v, Eigen::Vector3d(1, 0.2, 0));  // its own state stays
+
+  k[0]->set_bad();  // the chain's first keyframe: its successor starts the chain
+  const auto s2b = k[2]->imu();
+  EXPECT_EQ(s2b->previous, nullptr);
+  EXPECT_EQ(s2b->from_previous, nullptr);
+  EXPECT_EQ(k[2]->imu_next(), k[3]);
+  k[3]->set_bad();  // the last: its predecessor ends the chain
+  EXPECT_EQ(k[2]->imu_next(), nullptr);
+}
+
+TEST(KeyFrameImu, BaEstimatesAndTheWorldsTurn) {
+  Map map;
+  KeyFrame* kf = map.create_keyframe(data_at(0, 0.0), geometry::SE3());
+  EXPECT_FALSE(kf->has_imu());
+  EXPECT_THROW(kf->set_imu_velocity_and_bias(Eigen::Vector3d::Zero(), {}), std::logic_error);
+  kf->set_imu({Eigen::Vector3d(1, 2, 3), {}, nullptr, nullptr});
+  EXPECT_FALSE(kf->imu()->estimated);  // a seed
+  kf->set_imu_velocity_and_bias(Eigen::Vector3d(0, 1, 0), {Eigen::Vector3d(0.1, 0, 0), Eigen::Vector3d(0, 0, 0.2)});
+  EXPECT_TRUE(kf->imu()->estimated);
+  const geometry::SE3 T(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix(), Eigen::Vector3d(5, 0, 0));
+  map.transform_world(T);
+  EXPECT_LT((kf->imu()->v - Eigen::Vector3d(-1, 0, 0)).norm(), 1e-12);  // turns, does not move
+  EXPECT_EQ(kf->imu()->bias.acc, Eigen::Vector3d(0, 0, 0.2));          // the body's: unchanged
+}
+
+}  // namespace
+}  // namespace plslam::map

@@ -100,5 +100,25 @@ TEST(KeyframeCulling, CullsTheRedundantCovisiblesButNeverTheOriginNorALoopKeyfra
   EXPECT_FALSE(lk[1]->is_bad());
 }
 
+// A keyframe of the IMU chain is culled only when its neighbours' interval stays short, and never
+// the chain's last (tracking predicts from it); one outside a chain as before.
+TEST(KeyframeCulling, TheImuChainKeepsItsIntervalsShort) {
+  Row r;
+  map::KeyFrame* k[4];
+  for (int i = 0; i < 4; ++i) k[i] = r.add(i, r.close);
+  KeyframeCullingOptions o;
+  EXPECT_TRUE(imu_chain_allows_culling(*k[1], o));  // no IMU state
+  // The keyframes are 0.05 s apart: the limit is set from their spacing.
+  k[0]->set_imu({});
+  k[1]->set_imu({Eigen::Vector3d::Zero(), {}, k[0], nullptr});
+  k[2]->set_imu({Eigen::Vector3d::Zero(), {}, k[1], nullptr});
+  o.max_imu_interval_s = k[2]->timestamp() - k[0]->timestamp();
+  EXPECT_TRUE(imu_chain_allows_culling(*k[1], o));   // its neighbours just within the limit
+  EXPECT_TRUE(imu_chain_allows_culling(*k[0], o));   // the chain's first: its successor starts it
+  EXPECT_FALSE(imu_chain_allows_culling(*k[2], o));  // the chain's last
+  o.max_imu_interval_s *= 0.99;
+  EXPECT_FALSE(imu_chain_allows_culling(*k[1], o));
+}
+
 }  // namespace keyframe_culling_test
 }  // namespace plslam::mapping

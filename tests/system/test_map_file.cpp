@@ -304,7 +304,7 @@ TEST_F(MapReuse, LocalizationOnlyTracksEveryFrameInTheMapFrameAndAddsNothing) {
   EXPECT_EQ(stats["relocalizations"]["frames"], nlohmann::json::array({0}));
   // trajectory.tum holds only the trusted poses: the localized ones.
   EXPECT_EQ(tum_rows(out.path() / "loc" / "trajectory.tum"), localized);
-  EXPECT_NE(r.out.find(fmt::format("frame states: tracked 0, relocalized 0, localized {}, recovering {}, unanchored 0, lost 0",
+  EXPECT_NE(r.out.find(fmt::format("frame states: tracked 0, relocalized 0, localized {}, recovering {}, unanchored 0, inertial 0, lost 0",
                                    localized, first)),
             std::string::npos)
       << r.out;

@@ -65,7 +65,7 @@ TEST(RunImuInit, RenderedHandheldWalkIsInitialisedNearTheTruth) {
   test::TempDir tmp;
   const auto seq = tmp.path() / "office";
   const auto synth = test::run_cli("synth --out \"" + seq.string() +
-                                   "\" --scene office --frames 110 --seed 4 --motion handheld --imu-noise euroc");
+                                   "\" --scene office --frames 170 --seed 4 --motion handheld --imu-noise euroc");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   const auto imu = run_imu(seq, tmp.path() / "run");
   ASSERT_TRUE(imu.is_object());
@@ -117,6 +117,17 @@ TEST(RunImuInit, RenderedHandheldWalkIsInitialisedNearTheTruth) {
     const auto& first = rows.front().values;
     EXPECT_LT(Eigen::Vector3d(first[1], first[2], first[3]).norm(), 1e-9) << file;
   }
+
+  // From the turn on, tracking and local BA used the IMU; local BA's estimates of the biases at
+  // the end against the rendered IMU's (a random walk). Measured: gyro 1.5 % off, acc 0.015 m/s^2.
+  const auto& slam = imu["slam"];
+  EXPECT_EQ(slam["mode"], "stereo-inertial") << slam.dump();
+  EXPECT_GE(slam["imu_tracked_frames"].get<int>(), 30) << slam.dump();
+  ASSERT_TRUE(slam.contains("final_gyro_bias")) << slam.dump();
+  const auto last = io::read_numeric_rows(seq / "mav0" / "state_groundtruth_estimate0" / "data.csv").back().values;
+  const Eigen::Vector3d bg_end(last[11], last[12], last[13]), ba_end(last[14], last[15], last[16]);
+  EXPECT_LT((vec(slam["final_gyro_bias"]) - bg_end).norm(), 0.05 * bg_end.norm());
+  EXPECT_LT((vec(slam["final_acc_bias"]) - ba_end).norm(), 0.03);
 }
 
 }  // namespace

@@ -63,6 +63,7 @@ struct RunArgs {
   bool no_place_recognition = false;
   bool no_loop_closing = false;
   bool no_lines = false;
+  bool no_imu = false;
   bool quiet = false;
   bool realtime = false;
   ModeArgs mode;
@@ -136,6 +137,7 @@ std::string map_config_text(const RunArgs& args, io::DatasetFormat preset) {
   nlohmann::json j = {{"preset", preset == io::DatasetFormat::kKitti ? "kitti" : "euroc"},
                       {"config_file", args.config},
                       {"no_lines", args.no_lines},
+                      {"no_imu", args.no_imu},
                       {"no_loop_closing", args.no_loop_closing},
                       {"sequential", args.mode.sequential},
                       {"deterministic", !args.mode.sequential && !args.mode.free_running},
@@ -227,10 +229,10 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     loaded.reset();
   }
   system::RunReport report;
-  // With an IMU: visual-inertial initialisation, and then a gravity-aligned world (tracking does
-  // not use the IMU otherwise yet).
+  // With an IMU: visual-inertial initialisation, then a gravity-aligned world, tracking with the
+  // IMU and its factors in local BA (stereo-inertial). --no-imu: stereo only.
   const ImuData* imu = ds && ds->imu() ? &*ds->imu() : input.camera_imu ? &*input.camera_imu : nullptr;
-  if (imu) slam.set_imu(*imu);
+  if (imu && !args.no_imu) slam.set_imu(*imu);
   app::install_stop_signals();
   std::string fatal;
   const auto start = std::chrono::steady_clock::now();
@@ -449,6 +451,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     if (const auto& g = slam.gravity_alignment()) {
       spdlog::info("world: gravity-aligned (z up) from frame {} on; every output is in it", g->from_frame);
     }
+    spdlog::info("{}", slam.imu_summary());
   }
   if (ds && ds->ground_truth()) {
     // Tracked poses only: a prediction made while lost is not an estimate to score.
@@ -583,6 +586,7 @@ CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](C
                            sub.add_flag("--no-loop-closing", args->no_loop_closing,
                                         "No loop closing (odometry with local mapping only)");
                            sub.add_flag("--no-lines", args->no_lines, "Points only");
+                           sub.add_flag("--no-imu", args->no_imu, "Stereo only: leave the input's IMU unused");
                            sub.add_flag("--quiet", args->quiet, "No progress lines");
                            sub.add_flag("--realtime", args->realtime, "Pace the input at the dataset's frame rate")
                                ->excludes(camera);

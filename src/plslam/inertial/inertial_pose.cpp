@@ -111,6 +111,7 @@ InertialPoseResult optimize_pose_inertial(const geometry::StereoCamera& cam, con
   Vector15d g;
   p.evaluate(x, /*robust=*/false, &res.information, &g, &res.imu_cost);
   res.visual.T_cw = x.T_cw;
+  if (options.covariance) res.visual.covariance = visual.covariance(x.T_cw, res.visual.point_outlier, res.visual.line_outlier);
   res.state = {imu.body_pose(x.T_cw), x.v, x.bias};
   return res;
 }

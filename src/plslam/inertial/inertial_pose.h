@@ -73,8 +73,9 @@ struct InertialPoseResult {
 };
 
 // The frame's state from the initial guess (the IMU's prediction, or the motion model's), rounds
-// and outlier classification as optimize_pose (the same options; `covariance` is ignored: see
-// `information`).
+// and outlier classification as optimize_pose (the same options; with `covariance`,
+// visual.covariance is vision's alone, as optimize_pose gives it: the IMU's share depends on state
+// i's own error, which `information` leaves out).
 InertialPoseResult optimize_pose_inertial(const geometry::StereoCamera& cam, const InertialTerms& imu,
                                           const geometry::SE3& T_cw_init, const Eigen::Vector3d& v_init,
                                           const ImuBias& bias_init, const std::vector<optim::PosePointTerm>& points,

@@ -1,6 +1,7 @@
 #include "plslam/map/keyframe.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "plslam/map/map_line.h"
 #include "plslam/map/map_point.h"
@@ -240,8 +241,86 @@ IdSet<KeyFrame> KeyFrame::loop_edges() const {
   return loop_edges_;
 }
 
+bool KeyFrame::has_imu() const {
+  std::lock_guard lock(imu_mutex_);
+  return imu_.has_value();
+}
+
+std::optional<KeyFrameImu> KeyFrame::imu() const {
+  std::lock_guard lock(imu_mutex_);
+  return imu_;
+}
+
+void KeyFrame::set_imu(const KeyFrameImu& imu) {
+  {
+    std::lock_guard lock(imu_mutex_);
+    imu_ = imu;
+  }
+  if (imu.previous) {
+    std::lock_guard lock(imu.previous->imu_mutex_);
+    imu.previous->imu_next_ = this;
+  }
+}
+
+void KeyFrame::set_imu_velocity_and_bias(const Eigen::Vector3d& v, const inertial::ImuBias& bias) {
+  std::lock_guard lock(imu_mutex_);
+  if (!imu_) throw std::logic_error("KeyFrame::set_imu_velocity_and_bias: no IMU state");
+  imu_->v = v;
+  imu_->bias = bias;
+  imu_->estimated = true;
+}
+
+KeyFrame* KeyFrame::imu_next() const {
+  std::lock_guard lock(imu_mutex_);
+  return imu_next_;
+}
+
+void KeyFrame::rotate_imu_velocity(const Eigen::Matrix3d& R_new_old) {
+  std::lock_guard lock(imu_mutex_);
+  if (imu_) imu_->v = R_new_old * imu_->v;
+}
+
+void KeyFrame::leave_imu_chain() {
+  // One keyframe's IMU lock at a time, so that no two threads can wait on each other.
+  std::optional<KeyFrameImu> own;
+  KeyFrame* next = nullptr;
+  {
+    std::lock_guard lock(imu_mutex_);
+    if (!imu_) return;
+    own = imu_;
+    next = imu_next_;
+    imu_next_ = nullptr;
+    imu_->previous = nullptr;
+    imu_->from_previous.reset();
+  }
+  KeyFrame* previous = own->previous;
+  std::optional<inertial::ImuBias> previous_bias;
+  if (previous) {
+    std::lock_guard lock(previous->imu_mutex_);
+    previous->imu_next_ = next;
+    if (previous->imu_) previous_bias = previous->imu_->bias;
+  }
+  if (!next) return;
+  std::lock_guard lock(next->imu_mutex_);
+  if (!next->imu_) return;
+  auto& after = next->imu_->from_previous;
+  if (!previous_bias || !own->from_previous || !after) {
+    next->imu_->previous = nullptr;
+    after.reset();
+    return;
+  }
+  // The two intervals as one: the second's first sample is the first's last (both interpolated at
+  // this keyframe's time).
+  std::vector<ImuSample> samples = own->from_previous->samples();
+  samples.insert(samples.end(), after->samples().begin() + 1, after->samples().end());
+  after = std::make_shared<const inertial::Preintegration>(samples, own->from_previous->t_i(), after->t_j(),
+                                                           *previous_bias, after->noise());
+  next->imu_->previous = previous;
+}
+
 void KeyFrame::set_bad() {
   if (origin_) return;
+  leave_imu_chain();
   for (auto* kf : covisibles()) kf->erase_connection(this);
   for (std::size_t i = 0; i < points_.size(); ++i) {
     if (auto* p = map_point(static_cast<int>(i))) p->erase_observation(this);

@@ -8,10 +8,13 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <vector>
 
 #include "plslam/geometry/se3.h"
+#include "plslam/inertial/imu_bias.h"
+#include "plslam/inertial/preintegration.h"
 #include "plslam/map/by_id.h"
 #include "plslam/map/frame_data.h"
 
@@ -19,6 +22,23 @@ namespace plslam::map {
 
 class MapPoint;
 class MapLine;
+class KeyFrame;
+
+// What a keyframe of a visual-inertial map knows of the IMU (once it is initialised and the world
+// gravity-aligned): the body's velocity and the biases at the keyframe, and the IMU's motion since
+// the keyframe before it in time (the IMU chain, whose consecutive pairs local BA ties with IMU
+// factors). No predecessor: the chain starts here.
+struct KeyFrameImu {
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();  // world frame
+  inertial::ImuBias bias;
+  KeyFrame* previous = nullptr;
+  std::shared_ptr<const inertial::Preintegration> from_previous;  // set with `previous`
+  // v and bias are a visual-inertial BA's estimates; false: tracking's, or a seed from the
+  // positions, until a local BA with this keyframe's IMU factors estimates them. Tracking's own
+  // estimates, each made from the keyframe before held fixed, drift when no BA follows them (local
+  // mapping falling behind), so tracking builds on estimated states only.
+  bool estimated = false;
+};
 
 class KeyFrame {
  public:
@@ -88,9 +108,23 @@ class KeyFrame {
   // re-attaches it to the tree.
   void restore_graph(KeyFrame* parent, const IdMap<KeyFrame, int>& weights, const IdSet<KeyFrame>& loop_edges);
 
+  // The IMU state (nullopt: a keyframe of a visual-only map, or made before the initialisation).
+  bool has_imu() const;
+  std::optional<KeyFrameImu> imu() const;
+  // Sets it and makes this keyframe its predecessor's successor in the IMU chain.
+  void set_imu(const KeyFrameImu& imu);
+  // A BA's estimate (has_imu() must hold); it makes the state `estimated`.
+  void set_imu_velocity_and_bias(const Eigen::Vector3d& v, const inertial::ImuBias& bias);
+  // The keyframe after this one in the IMU chain, null at its end.
+  KeyFrame* imu_next() const;
+  // Rotates the velocity with the world (Map::transform_world).
+  void rotate_imu_velocity(const Eigen::Matrix3d& R_new_old);
+
   // Never removes the origin. Otherwise: detaches from points, lines and the graph,
   // re-parents its children to their best covisible candidate, and remembers its pose relative
-  // to its parent so that frames that referenced it keep a valid pose.
+  // to its parent so that frames that referenced it keep a valid pose. In the IMU chain its
+  // successor follows its predecessor directly, with the two intervals' samples integrated again
+  // as one (at the predecessor's bias).
   void set_bad();
   // Inline and lock-free, as Landmark::is_bad: local mapping asks it of every observing keyframe
   // of every landmark it touches.
@@ -112,6 +146,10 @@ class KeyFrame {
   std::vector<MapPoint*> points_;
   std::vector<MapLine*> lines_;
 
+  mutable std::mutex imu_mutex_;
+  std::optional<KeyFrameImu> imu_;
+  KeyFrame* imu_next_ = nullptr;
+
   mutable std::mutex graph_mutex_;
   IdMap<KeyFrame, int> weights_;
   std::vector<KeyFrame*> ordered_;  // covisibles by decreasing weight
@@ -124,6 +162,8 @@ class KeyFrame {
   geometry::SE3 T_cp_;
 
   void sort_connections_locked();
+  // set_bad()'s part for the IMU chain.
+  void leave_imu_chain();
 };
 
 }  // namespace plslam::map

@@ -150,7 +150,10 @@ void Map::transform_world(const geometry::SE3& T_new_old) {
     for (const auto& p : all_points_) points.push_back(p.get());
     for (const auto& l : all_lines_) lines.push_back(l.get());
   }
-  for (KeyFrame* kf : keyframes) kf->set_pose(kf->pose() * T_old_new);
+  for (KeyFrame* kf : keyframes) {
+    kf->set_pose(kf->pose() * T_old_new);
+    kf->rotate_imu_velocity(R);
+  }
   for (MapPoint* p : points) {
     p->set_position(T_new_old * p->position());
     p->rotate_normal(R);

@@ -26,13 +26,23 @@ bool is_redundant(const map::KeyFrame& k, const KeyframeCullingOptions& o) {
   return total > 0 && redundant > o.redundancy * total;
 }
 
+bool imu_chain_allows_culling(const map::KeyFrame& k, const KeyframeCullingOptions& o) {
+  const auto imu = k.imu();
+  if (!imu) return true;
+  const map::KeyFrame* next = k.imu_next();
+  // The chain's last keyframe is where tracking's IMU prediction starts.
+  if (!next) return false;
+  if (!imu->previous) return true;
+  return next->timestamp() - imu->previous->timestamp() <= o.max_imu_interval_s;
+}
+
 std::vector<map::KeyFrame*> cull_redundant_keyframes(map::Map& map, const map::KeyFrame& kf,
                                                      const KeyframeCullingOptions& o,
                                                      const std::function<void(map::KeyFrame*)>& on_culled) {
   std::vector<map::KeyFrame*> culled;
   for (map::KeyFrame* k : kf.covisibles()) {
     if (k->is_origin() || k->is_bad() || !k->loop_edges().empty()) continue;
-    if (!is_redundant(*k, o)) continue;
+    if (!is_redundant(*k, o) || !imu_chain_allows_culling(*k, o)) continue;
     k->set_bad();
     map.erase_keyframe(k);
     if (on_culled) on_culled(k);

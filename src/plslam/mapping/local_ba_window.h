@@ -5,6 +5,7 @@
 #include <atomic>
 #include <vector>
 
+#include "plslam/inertial/preintegration.h"
 #include "plslam/map/map.h"
 #include "plslam/mapping/map_ba_problem.h"
 #include "plslam/optim/bundle_adjustment.h"
@@ -18,17 +19,26 @@ struct LocalBaOptions {
   double line_information = 0.5;
   double far_stereo_baselines = 0;
   bool lines = true;
+  // A visual-inertial map: the window also holds the last `imu_window` keyframes of the new
+  // keyframe's IMU chain (map::KeyFrameImu), free, with their velocities and biases and an IMU
+  // factor between each consecutive pair, and the keyframe before them held fixed (ORB-SLAM3's
+  // local inertial BA). 0: no IMU in local BA. `T_imu_cam` is the input's (ImuData::T_imu_cam).
+  int imu_window = 0;
+  geometry::SE3 T_imu_cam;
+  // A factor's preintegration is integrated again once its first keyframe's bias moved this far
+  // from the bias it was integrated at.
+  inertial::ReintegrationThresholds reintegration;
 };
 
 // The window of `kf`: it and its good covisibles are optimised, except the map's origin, which
 // stays fixed; so are the points (and lines) they see; every other good keyframe that sees those
-// landmarks joins fixed. `also_free`: keyframes optimised with them, covisible or not (the
+// landmarks joins fixed (with the IMU chain's keyframes when o.imu_window > 0). `also_free`: keyframes optimised with them, covisible or not (the
 // keyframes mapped before `kf` in one go, whose BA this one is; bad ones are left out).
 MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o,
                              const std::vector<map::KeyFrame*>& also_free = {});
 
 // Writes a BA result of `window` back into the map: removes the outlier observations, sets the
-// poses of the free keyframes, the positions of good points and the endpoints of good lines (each
+// poses of the free keyframes (and the velocities and biases of those in its IMU chain), the positions of good points and the endpoints of good lines (each
 // line refitted to its observations), with their normals and ranges. The caller holds the map's
 // update mutex.
 void write_back_local_ba(const MapBaProblem& window, const optim::BaResult& result);

@@ -56,6 +56,9 @@ struct LocalMapperOptions {
   // on, about 2.2 ms per 1000 alone, more beside tracking), and a window after a loop has twice
   // the usual. 0: by frames only.
   double ba_merge_ms_per_1000_observations = 3.0;
+  // Keyframes of the IMU chain that local BA optimises with their IMU factors once use_imu() was
+  // called (LocalBaOptions::imu_window; ORB-SLAM3: 10).
+  int imu_window = 10;
 };
 
 struct LocalMapperStats {
@@ -114,6 +117,12 @@ class LocalMapper {
   // Forgets the culled landmarks it keeps between keyframes (before Map::reclaim()); call while
   // paused with try_pause(), or from the thread that calls process_pending().
   void drop_bad_landmarks() { recent_.drop_bad(); }
+  // The map is visual-inertial from now on (its keyframes get IMU states): local BA takes the IMU
+  // chain's factors (LocalMapperOptions::imu_window). Call as drop_bad_landmarks().
+  void use_imu(const geometry::SE3& T_imu_cam) {
+    options_.ba.imu_window = options_.imu_window;
+    options_.ba.T_imu_cam = T_imu_cam;
+  }
   std::size_t queued() const;
   // Processes every queued keyframe in the calling thread (deterministic mode and tests).
   void process_pending();

@@ -32,17 +32,7 @@ PoseOnlyResult optimize_pose(const geometry::StereoCamera& cam, const SE3& T_cw_
       },
       [](const SE3& x, const Vector6d& delta) { return SE3::exp(delta) * x; }, [](const SE3& x) { return x; });
   res.T_cw = T;
-  if (options.covariance) {
-    Matrix6d H = Matrix6d::Zero();
-    Vector6d g = Vector6d::Zero();
-    p.evaluate(T, res.point_outlier, res.line_outlier, /*robust=*/false, &H, &g);
-    const Eigen::LDLT<Matrix6d> ldlt(H);
-    // A direction no inlier observes (a rank-deficient H) has no finite covariance.
-    if (ldlt.info() == Eigen::Success && ldlt.isPositive() && (ldlt.vectorD().array() > 1e-9 * H.diagonal().maxCoeff()).all()) {
-      res.covariance = ldlt.solve(Matrix6d::Identity());
-      res.covariance = 0.5 * (res.covariance + res.covariance.transpose()).eval();
-    }
-  }
+  if (options.covariance) res.covariance = p.covariance(T, res.point_outlier, res.line_outlier);
   return res;
 }
 

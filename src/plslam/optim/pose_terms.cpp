@@ -1,5 +1,7 @@
 #include "plslam/optim/pose_terms.h"
 
+#include <Eigen/Cholesky>
+
 #include "plslam/optim/stereo_line_residual.h"
 #include "plslam/optim/stereo_point_residual.h"
 
@@ -96,6 +98,21 @@ double PoseTerms::classify(const SE3& T, std::vector<bool>* point_out, std::vect
     (*line_out)[i] = out;
   }
   return cost;
+}
+
+geometry::Matrix6d PoseTerms::covariance(const geometry::SE3& T_cw, const std::vector<bool>& point_out,
+                                         const std::vector<bool>& line_out) const {
+  geometry::Matrix6d H = geometry::Matrix6d::Zero();
+  geometry::Vector6d g = geometry::Vector6d::Zero();
+  evaluate(T_cw, point_out, line_out, /*robust=*/false, &H, &g);
+  const Eigen::LDLT<geometry::Matrix6d> ldlt(H);
+  // A direction no inlier observes (a rank-deficient H) has no finite covariance.
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
+      !(ldlt.vectorD().array() > 1e-9 * H.diagonal().maxCoeff()).all()) {
+    return geometry::Matrix6d::Zero();
+  }
+  const geometry::Matrix6d C = ldlt.solve(geometry::Matrix6d::Identity());
+  return 0.5 * (C + C.transpose());
 }
 
 }  // namespace plslam::optim

@@ -24,6 +24,10 @@ class PoseTerms {
                   bool robust, geometry::Matrix6d* H, geometry::Vector6d* g) const;
   // Flags every term by its chi-square gate at T_cw; returns the kernel-free cost of the inliers.
   double classify(const geometry::SE3& T_cw, std::vector<bool>* point_out, std::vector<bool>* line_out) const;
+  // The inverse of the inliers' information J' W J at T_cw (no kernels): the pose's covariance as
+  // vision alone gives it (PoseOnlyResult::covariance); zero when a direction is unobserved.
+  geometry::Matrix6d covariance(const geometry::SE3& T_cw, const std::vector<bool>& point_out,
+                                const std::vector<bool>& line_out) const;
 
   std::size_t num_points() const { return points_.size(); }
   std::size_t num_lines() const { return lines_.size(); }

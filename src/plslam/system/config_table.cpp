@@ -367,6 +367,23 @@ std::vector<ConfigKey> make_table() {
           "deterministic mode: a loop correction's essential graph is solved beside tracking and the rest of "
           "the map moves before the frame this many frames after the correction began", at_least(1)),
 
+    field("imu", "visual_inertial", [](auto& o) -> auto& { return o.visual_inertial; },
+          "once the IMU is initialised, tracking and local BA use it (false: it only turns the world to gravity)"),
+    field("imu", "local_ba_keyframes", [](auto& o) -> auto& { return o.mapper.imu_window; },
+          "keyframes of the IMU chain that local BA optimises with their IMU factors", at_least(1)),
+    field("imu", "max_keyframe_interval_s", [](auto& o) -> auto& { return o.tracker.imu.max_keyframe_interval_s; },
+          "with the IMU, a keyframe is due once the last one is this old (preintegration stays short)", at_least(0.05)),
+    field("imu", "max_culled_interval_s", [](auto& o) -> auto& { return o.mapper.keyframe_culling.max_imu_interval_s; },
+          "a keyframe of the IMU chain is culled only if its neighbours are then at most this far apart in time",
+          at_least(0.05)),
+    field("imu", "max_prediction_s", [](auto& o) -> auto& { return o.tracker.imu.max_prediction_s; },
+          "the IMU predicts a frame from the newest keyframe whose state local BA estimated, at most this much older",
+          at_least(0.05)),
+    field("imu", "max_texture_points", [](auto& o) -> auto& { return o.tracker.imu.max_texture_points; },
+          "only a frame with fewer stereo points than this is carried by the IMU when vision fails", at_least(0)),
+    field("imu", "max_inertial_s", [](auto& o) -> auto& { return o.tracker.imu.max_inertial_s; },
+          "frames vision cannot track take the IMU's pose for at most this long, then the camera is lost",
+          at_least(0)),
     unsigned_field("system", "seed", [](auto& o) -> auto& { return o.seed; },
                    "seed of every random choice (the PnP RANSAC of relocalization and loop closing)", at_least(0)),
   };

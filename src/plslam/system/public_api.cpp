@@ -41,7 +41,8 @@ static_assert(static_cast<int>(FrameState::kLocalized) == static_cast<int>(track
                   static_cast<int>(FrameState::kRecovering) == static_cast<int>(tracking::FrameState::kRecovering) &&
                   static_cast<int>(FrameState::kRelocalized) == static_cast<int>(tracking::FrameState::kRelocalized) &&
                   static_cast<int>(FrameState::kTracked) == static_cast<int>(tracking::FrameState::kTracked) &&
-                  static_cast<int>(FrameState::kUnanchored) == static_cast<int>(tracking::FrameState::kUnanchored),
+                  static_cast<int>(FrameState::kUnanchored) == static_cast<int>(tracking::FrameState::kUnanchored) &&
+                  static_cast<int>(FrameState::kInertial) == static_cast<int>(tracking::FrameState::kInertial),
               "the public FrameState mirrors tracking::FrameState");
 
 TrackingState public_state(tracking::TrackingState s) {

@@ -235,14 +235,14 @@ std::string RunReport::summary(const System& slam) const {
   return fmt::format(
       "frames {} (tracked {}, skipped {}), lost events {}, relocalizations {}, new map segments {}, loops {}, "
       "keyframes {}, map points {}, map lines {}\n"
-      "frame states: tracked {}, relocalized {}, localized {}, recovering {}, unanchored {}, lost {}\n"
+      "frame states: tracked {}, relocalized {}, localized {}, recovering {}, unanchored {}, inertial {}, lost {}\n"
       "tracking ms/frame: median {:.1f}, mean {:.1f}, p90 {:.1f}\n",
       frames, tracked_frames, skipped.size(), slam.tracker().lost_events(), slam.tracker().relocalized_frames().size(),
       slam.tracker().new_segment_frames().size(), slam.loop_closer() ? slam.loop_closer()->stats().loops.size() : 0,
       slam.map().num_keyframes(), slam.map().num_points(),
       slam.map().num_lines(), count(FrameState::kTracked), count(FrameState::kRelocalized),
       count(FrameState::kLocalized), count(FrameState::kRecovering), count(FrameState::kUnanchored),
-      count(FrameState::kLost),
+      count(FrameState::kInertial), count(FrameState::kLost),
       percentile(tracking_ms, 0.5), mean(tracking_ms), percentile(tracking_ms, 0.9));
 }
 

@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <chrono>
 
+#include <fmt/format.h>
+
 namespace plslam::system {
 
 SystemOptions SystemOptions::euroc() {
@@ -227,6 +229,11 @@ void System::align_world_with_gravity(long frame_id) {
     map_.transform_world(T_new_old);
     tracker_->transform_world(T_new_old);
     gravity_alignment_ = GravityAlignment{T_new_old.rotation(), frame_id};
+    // The IMU's residuals assume gravity along -z: from here on tracking and local BA use them.
+    if (options_.visual_inertial) {
+      tracker_->use_imu(*imu_data_, imu_init_->result()->bias);
+      mapper_->use_imu(geometry::SE3(imu_data_->T_imu_cam.linear(), imu_data_->T_imu_cam.translation()));
+    }
     if (loop_closer_) loop_closer_->resume();
   }
   mapper_->resume();
@@ -243,7 +250,40 @@ nlohmann::json System::imu_report() const {
     world["kept"] = map_loaded_ ? "the loaded map's" : "the first keyframe's camera";
   }
   j["world"] = world;
+  const bool inertial = tracker_->imu_on();
+  nlohmann::json slam = {{"mode", inertial ? "stereo-inertial" : "stereo"},
+                         {"imu_tracked_frames", tracker_->imu_tracked_frames()},
+                         {"inertial_frames", tracker_->inertial_frames()}};
+  if (gravity_alignment_ && inertial) slam["from_frame"] = gravity_alignment_->from_frame;
+  if (const auto bias = final_imu_bias()) {
+    slam["final_gyro_bias"] = {bias->gyro.x(), bias->gyro.y(), bias->gyro.z()};
+    slam["final_acc_bias"] = {bias->acc.x(), bias->acc.y(), bias->acc.z()};
+  }
+  j["slam"] = slam;
   return j;
+}
+
+std::optional<inertial::ImuBias> System::final_imu_bias() const {
+  const auto keyframes = map_.keyframes();
+  for (auto it = keyframes.rbegin(); it != keyframes.rend(); ++it) {
+    if (const auto imu = (*it)->imu(); imu && imu->estimated) return imu->bias;
+  }
+  return std::nullopt;
+}
+
+std::string System::imu_summary() const {
+  if (!imu_init_) return "mode: stereo (no IMU)";
+  if (!tracker_->imu_on()) {
+    return gravity_alignment_ ? "mode: stereo, the IMU only turned the world to gravity"
+                              : "mode: stereo (the IMU was never initialised)";
+  }
+  std::string s = fmt::format("mode: stereo-inertial from frame {} ({} frames tracked with the IMU, {} carried by it alone)",
+                              gravity_alignment_->from_frame, tracker_->imu_tracked_frames(), tracker_->inertial_frames());
+  if (const auto b = final_imu_bias()) {
+    s += fmt::format("; final biases: gyro [{:.4f} {:.4f} {:.4f}] rad/s, acc [{:.3f} {:.3f} {:.3f}] m/s^2", b->gyro.x(),
+                     b->gyro.y(), b->gyro.z(), b->acc.x(), b->acc.y(), b->acc.z());
+  }
+  return s;
 }
 
 void WaitStats::add(double ms) {

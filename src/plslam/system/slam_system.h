@@ -52,6 +52,10 @@ struct SystemOptions {
   // Localization in a loaded map (--localize): no keyframes, points or lines are added, and
   // neither local mapping nor loop closing runs.
   bool localization_only = false;
+  // With an IMU (set_imu): once it is initialised, tracking predicts and optimises with it and
+  // local BA keeps the IMU's factors (stereo-inertial). false: the IMU only turns the world to
+  // gravity (stereo).
+  bool visual_inertial = true;
 
   static SystemOptions euroc();
   static SystemOptions kitti();
@@ -124,6 +128,10 @@ class System {
   const std::optional<GravityAlignment>& gravity_alignment() const { return gravity_alignment_; }
   // stats.json's "imu": the monitor's report and the world's alignment; null without an IMU.
   nlohmann::json imu_report() const;
+  // One log line: stereo or stereo-inertial, from which frame, and the final bias estimates.
+  std::string imu_summary() const;
+  // The last keyframe's estimated biases (a stereo-inertial run), else nothing.
+  std::optional<inertial::ImuBias> final_imu_bias() const;
 
   // The trusted frames only (tracking::is_trusted: never a prediction made while lost or before
   // initialisation, nor a pose recovering from an unconfirmed relocalization), T_world_leftcam with

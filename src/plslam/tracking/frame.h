@@ -2,9 +2,11 @@
 // The frame being tracked: its extracted features (shared with the keyframe it may become), its
 // pose, and its current associations to map points and map lines.
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "plslam/geometry/se3.h"
+#include "plslam/inertial/imu_bias.h"
 #include "plslam/map/frame_data.h"
 
 namespace plslam::map {
@@ -32,6 +34,12 @@ struct Frame {
   map::KeyFrame* reference = nullptr;
   // Of the last pose optimisation against the local map (optim::PoseOnlyResult::covariance).
   geometry::Matrix6d pose_covariance = geometry::Matrix6d::Zero();
+  // Tracked with the IMU (Tracker::use_imu): the body's velocity (world) and the biases.
+  struct Imu {
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    inertial::ImuBias bias;
+  };
+  std::optional<Imu> imu;
 
   long id() const { return data->frame_id; }
   Eigen::Vector3d camera_center() const { return T_cw.inverse().translation(); }

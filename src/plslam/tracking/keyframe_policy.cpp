@@ -30,6 +30,7 @@ const char* to_string(KeyframeReason r) {
     case KeyframeReason::kCloseDepth: return "close-depth";
     case KeyframeReason::kMaxFrames: return "max-frames";
     case KeyframeReason::kVelocity: return "velocity";
+    case KeyframeReason::kImuInterval: return "imu-interval";
   }
   return "?";
 }

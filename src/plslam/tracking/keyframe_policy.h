@@ -66,7 +66,8 @@ struct KeyframeInputs {
   int keyframes_queued = 0;         // keyframes waiting for local mapping
 };
 
-enum class KeyframeReason { kNone, kInlierRatio, kCloseDepth, kMaxFrames, kVelocity };
+// kImuInterval: tracking with the IMU keeps keyframes close in time (ImuTrackingOptions).
+enum class KeyframeReason { kNone, kInlierRatio, kCloseDepth, kMaxFrames, kVelocity, kImuInterval };
 const char* to_string(KeyframeReason r);
 
 struct KeyframeDecision {

@@ -49,6 +49,7 @@ const char* to_string(FrameState s) {
     case FrameState::kTracked: return "tracked";
     case FrameState::kLocalized: return "localized";
     case FrameState::kUnanchored: return "unanchored";
+    case FrameState::kInertial: return "inertial";
   }
   return "?";
 }
@@ -71,6 +72,7 @@ double Tracker::close_depth(const Frame& f) const {
 }
 
 geometry::SE3 Tracker::predicted_pose(const Frame& f) const {
+  if (prior_) return prior_->T_cw;
   if (!last_) return f.T_cw;
   if (!velocity_) return last_->T_cw;
   return predict_pose(*velocity_, velocity_dt_, f.data->timestamp - last_->data->timestamp, last_->T_cw);
@@ -193,6 +195,9 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     seen_big_changes_ = changes;
     if (last_ && !records_.empty() && records_.back().reference) last_->T_cw = pose_of(records_.back());
   }
+  prior_.reset();
+  if (state_ == TrackingState::kOk) prior_ = imu_prior(f);
+  bool inertial = false;
 
   bool ok = false;
   auto clear_matches = [&f] {
@@ -228,6 +233,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     // reversed path keeps many more than matching the reference keyframe's descriptors.
     if (velocity_ || recovery_) tracked = track_with_motion_model(f, result.times);
     if (!tracked) tracked = track_reference_keyframe(f, result.times);
+    if (!tracked) tracked = track_from_imu_prediction(f, result.times);
     if (tracked) {
       tracked = track_local_map(f, result.times, result.point_inliers, result.line_inliers);
     }
@@ -250,7 +256,8 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     // look-alike where it points would be tracked as if the camera had not been moved. The pose
     // recovers like a relocalization's, this frame checked too.
     const double gap = f.data->timestamp - last_->data->timestamp;
-    if (tracked && !recovery_ && options_.recover_after_gap_s > 0 && gap > options_.recover_after_gap_s) {
+    // (The IMU carried the pose across the gap: it is no guess.)
+    if (tracked && !recovery_ && !prior_ && options_.recover_after_gap_s > 0 && gap > options_.recover_after_gap_s) {
       spdlog::info("frame {}: tracked after a {:.2f} s gap, recovering until confirmed", f.id(), gap);
       recovery_ = Recovery{f.id(), 0, f.T_cw, true, trusted_since_recovery_};
       trusted_since_recovery_ = false;
@@ -281,8 +288,21 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
         if (recovery_confirmed(f)) confirm_relocalization(f, result);
       }
       finish_tracked_frame(f, result);
+      last_visual_t_ = f.data->timestamp;
+      if (f.imu) {
+        last_bias_ = f.imu->bias;
+        ++imu_tracked_frames_;
+      }
+    } else if (prior_ && (spdlog::debug("frame {}: vision failed; the IMU predicts it from keyframe {}, {:.2f} s earlier, at ({:.3f} {:.3f} {:.3f})",
+                                        f.id(), prior_->keyframe->id(), prior_->pim->dt(), prior_->T_cw.inverse().translation().x(),
+                                        prior_->T_cw.inverse().translation().y(), prior_->T_cw.inverse().translation().z()),
+                          !recovery_ && carry_by_imu(f))) {
+      ok = true;
+      inertial = true;
     } else {
       recovery_.reset();
+      prior_.reset();
+      imu_chain_live_ = false;
       ++lost_events_;
       const bool relocalizing = relocalization_on();
       spdlog::warn("frame {}: tracking lost (event {}), {}", f.id(), lost_events_,
@@ -313,6 +333,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     } else {
       fs = result.relocalized ? FrameState::kRelocalized : FrameState::kTracked;
     }
+    if (inertial) fs = FrameState::kInertial;
   }
   FrameRecord rec;
   rec.frame_id = f.id();
@@ -330,7 +351,8 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   result.frame_state = fs;
   if (ok) result.pose_covariance = f.pose_covariance;
   result.tracked = rec.trusted();
-  last_ = std::move(f);
+  // An inertial frame matched nothing: the next frame searches the last one vision tracked.
+  if (!inertial) last_ = std::move(f);
   return result;
 }
 
@@ -405,6 +427,12 @@ void Tracker::finish_tracked_frame(Frame& f, TrackResult& result) {
   result.local_points = static_cast<int>(local_points_.size());
   result.local_lines = static_cast<int>(local_lines_.size());
   // No keyframe from an unconfirmed relocalization: a look-alike place must not grow the map.
+  // With the IMU, keyframes stay close in time for preintegration.
+  if (imu_ && !result.decision.insert && !result.decision.queue_full && last_keyframe_ &&
+      f.data->timestamp - last_keyframe_->timestamp() >= options_.imu.max_keyframe_interval_s) {
+    result.decision.insert = true;
+    result.decision.reason = KeyframeReason::kImuInterval;
+  }
   if (result.decision.insert && !options_.localization_only && !recovery_) {
     create_keyframe(f);
     policy_.keyframe_inserted(inputs);
@@ -441,6 +469,11 @@ bool Tracker::initialize(Frame& f) {
     for (std::size_t j = 0; j < d.lines.size(); ++j) {
       if (d.lines[j].stereo) create_stereo_line(f, kf, j);
     }
+  }
+  if (imu_) {
+    imu_chain_live_ = false;  // a new segment: a new chain
+    kf->set_imu(keyframe_imu(f));
+    imu_chain_live_ = true;
   }
   f.reference = kf;
   reference_ = kf;
@@ -487,6 +520,11 @@ int Tracker::optimize_pose(Frame& f, TrackStageTimes& t, bool covariance) {
   auto popts = options_.pose;
   popts.scale_factor = d.scale_factor;
   popts.covariance = covariance;
+  if (prior_) {
+    const int inliers = optimize_pose_inertial(f, pts, lns, popts);
+    t.pose_optimization_ms += ms_since(t0);
+    return inliers;
+  }
   const auto r = optim::optimize_pose(cam, f.T_cw, pts, lns, popts);
   f.T_cw = r.T_cw.normalized();
   f.pose_covariance = r.covariance;
@@ -574,7 +612,7 @@ bool Tracker::track_reference_keyframe(Frame& f, TrackStageTimes& t) {
       // was tracked at 0.5 m/s instead of 10, ATE 7.3 m, every frame "OK"). PnP RANSAC on the
       // same matches gives a second start; the optimisation that keeps more inliers wins.
       const Frame matched = f;
-      f.T_cw = last_->T_cw;
+      f.T_cw = prior_ ? prior_->T_cw : last_->T_cw;
       int inliers = optimize_pose(f, t);
       if (const auto pnp = pnp_from_matches(matched); pnp) {
         Frame from_pnp = matched;
@@ -778,6 +816,10 @@ map::KeyFrame* Tracker::create_keyframe(Frame& f) {
       if (0.5 * (l.start_cam.z() + l.end_cam.z()) > th) continue;
       create_stereo_line(f, kf, j);
     }
+  }
+  if (imu_) {
+    kf->set_imu(keyframe_imu(f));
+    imu_chain_live_ = true;
   }
   reference_ = kf;
   f.reference = kf;

@@ -9,8 +9,10 @@
 #include <optional>
 #include <vector>
 
+#include "plslam/core/imu.h"
 #include "plslam/core/pointer_set.h"
 #include "plslam/geometry/se3.h"
+#include "plslam/inertial/inertial_pose.h"
 #include "plslam/map/map.h"
 #include "plslam/optim/pose_only.h"
 #include "plslam/tracking/frame.h"
@@ -74,6 +76,26 @@ struct RelocalizationOptions {
   double continuity_s = 0;
 };
 
+// Tracking with the IMU, once the map is gravity-aligned (Tracker::use_imu).
+struct ImuTrackingOptions {
+  // Keyframes of the IMU chain started at use_imu(): the last ones, their velocities estimated from
+  // their positions until local BA settles them (LocalMapperOptions::imu_window).
+  int seed_keyframes = 10;
+  // A keyframe is due once the last one is this old: preintegration stays short (ORB-SLAM3: 0.5 s).
+  double max_keyframe_interval_s = 0.5;
+  // The IMU predicts from the newest keyframe of the chain whose state a local BA estimated
+  // (map::KeyFrameImu::estimated), if it is at most this much older than the frame.
+  double max_prediction_s = 1.5;
+  // Only a frame with fewer stereo points than this (a black or blurred image, a covered lens) is
+  // carried by the IMU when vision fails; a textured frame vision cannot track is lost, as without
+  // an IMU (its failure is no lack of texture, and the IMU cannot tell what else went wrong).
+  int max_texture_points = 50;
+  // A frame that vision cannot track (a black or blurred image, a covered lens) takes the IMU's
+  // prediction, state `inertial`, for at most this long after the last frame vision tracked;
+  // then the camera is lost, as without an IMU.
+  double max_inertial_s = 3.0;
+};
+
 struct TrackerOptions {
   int init_min_points = 500;          // stereo points needed to start a map
   double close_depth_baselines = 40;  // "close" stereo points: depth < 40 baselines (ORB-SLAM2)
@@ -125,6 +147,7 @@ struct TrackerOptions {
   KeyframePolicyOptions keyframe;
   int local_keyframes_max = 80;
   RelocalizationOptions relocalization;
+  ImuTrackingOptions imu;
   std::uint32_t seed = 1;  // of the relocalization's PnP RANSAC (SystemOptions::seed)
   // Localization in a loaded map: no keyframe is created and a lost camera never starts a new
   // map segment; it waits for relocalization instead.
@@ -140,17 +163,19 @@ const char* to_string(TrackingState s);
 //   relocalized  the frame that confirmed a relocalization: trusted;
 //   localized    tracked in a loaded map, localization only (--localize): trusted;
 //   lost         no pose (lost, or before the map started);
+//   inertial     vision could not track it (no texture): the IMU carried the pose from the last
+//                keyframe, for a few seconds at most (ImuTrackingOptions::max_inertial_s): trusted;
 //   unanchored   tracked in a new map segment that no loop has tied to the map yet: right
 //                relative to the segment's other frames, but the segment's place in the map is
 //                the motion model's guess across the loss. Not trusted; the run's outputs count
 //                it tracked if a loop ties the segment before the end (Tracker::settle_states).
-enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized, kUnanchored };
+enum class FrameState { kLost, kRecovering, kRelocalized, kTracked, kLocalized, kUnanchored, kInertial };
 const char* to_string(FrameState s);
 // The states whose pose plslam stands behind (trajectory.tum holds only these).
 constexpr bool is_trusted(FrameState s) {
   return s != FrameState::kLost && s != FrameState::kRecovering && s != FrameState::kUnanchored;
 }
-constexpr int kFrameStates = 6;
+constexpr int kFrameStates = 7;
 
 struct TrackStageTimes {
   double track_motion_ms = 0;     // motion model or reference keyframe, search + optimisation
@@ -208,6 +233,16 @@ class Tracker {
           std::function<bool()> mapping_idle);
 
   TrackResult track(std::shared_ptr<const map::FrameData> data);
+  // The map is gravity-aligned (z up, the IMU initialised with `bias`): the last
+  // options.imu.seed_keyframes keyframes start the IMU chain (map::KeyFrameImu), and from the
+  // next frame on, once local BA has estimated the last keyframe's velocity, the IMU predicts each
+  // frame from it and the pose optimisation adds the IMU's residual (inertial/inertial_pose.h).
+  // `imu` is not owned and must outlive the tracker.
+  void use_imu(const ImuData& imu, const inertial::ImuBias& bias);
+  bool imu_on() const { return imu_ != nullptr; }
+  // Frames tracked with the IMU's residual, and frames the IMU carried alone (state inertial).
+  int imu_tracked_frames() const { return imu_tracked_frames_; }
+  int inertial_frames() const { return inertial_frames_; }
   // Place recognition for relocalization; without one, a lost camera starts a new map segment on
   // the next frame that can. Not owned; must outlive the tracker.
   void set_keyframe_database(const place::KeyframeDatabase* database) { database_ = database; }
@@ -265,6 +300,26 @@ class Tracker {
 
  private:
   bool initialize(Frame& f);
+  // The IMU's prediction of the frame being tracked, from the last keyframe's estimated state
+  // (tracker_inertial.cpp).
+  struct ImuPrior {
+    const map::KeyFrame* keyframe = nullptr;  // the estimated keyframe it predicts from
+    inertial::InertialState from;  // the keyframe's
+    std::shared_ptr<const inertial::Preintegration> pim;  // keyframe -> frame
+    inertial::InertialState predicted;
+    geometry::SE3 T_cw;  // the camera's predicted pose
+  };
+  std::optional<ImuPrior> imu_prior(const Frame& f) const;
+  // The IMU state a keyframe made from `f` starts with, chained to the last keyframe's.
+  map::KeyFrameImu keyframe_imu(const Frame& f) const;
+  // optimize_pose with the IMU's residual from prior_ (f.imu gets the velocity and biases).
+  int optimize_pose_inertial(Frame& f, const std::vector<optim::PosePointTerm>& points,
+                             const std::vector<optim::PoseLineTerm>& lines, const optim::PoseOnlyOptions& options);
+  // A frame vision could not track, within max_inertial_s of the last it did: the IMU's pose.
+  bool carry_by_imu(Frame& f);
+  // After a gap the last frame's matches and the reference keyframe may be out of view: the map
+  // points of the keyframes nearest the IMU's predicted pose, searched by projection from it.
+  bool track_from_imu_prediction(Frame& f, TrackStageTimes& t);
   bool track_with_motion_model(Frame& f, TrackStageTimes& t);
   // Pose from PnP RANSAC on the frame's point matches, when it succeeds.
   std::optional<geometry::SE3> pnp_from_matches(const Frame& f) const;
@@ -366,6 +421,16 @@ class Tracker {
   std::optional<double> lost_since_;  // first textured frame that failed to relocalize
   std::vector<long> relocalized_frames_;
   std::vector<long> new_segment_frames_;
+
+  const ImuData* imu_ = nullptr;
+  geometry::SE3 T_imu_cam_;
+  std::optional<ImuPrior> prior_;  // of the frame being tracked, on its normal path only
+  inertial::ImuBias last_bias_;    // the latest estimate (seeds)
+  std::optional<double> last_visual_t_;  // the last frame vision tracked
+  // The IMU chain reaches the current frame: tracked without a loss since its last keyframe.
+  bool imu_chain_live_ = false;
+  int imu_tracked_frames_ = 0;
+  int inertial_frames_ = 0;
 };
 
 }  // namespace plslam::tracking

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# Stereo-inertial against stereo-only (issue 53): the office loop rendered with each motion profile
+# and seed, EuRoC's IMU noise and non-zero biases, run by `plslam run` with the IMU and with
+# --no-imu (loop closing on). Per run: the ATE (se3), frames tracked, lost events, relocalizations,
+# new map segments, frames tracked with the IMU and carried by it alone, and the ratio of the two
+# ATEs. With --blackout S, frames S..S+19 (1 s) of both cameras are replaced by black images in a
+# copy of each render (its ATE against the same run without the black-out is the issue's bar).
+#
+#   bench/stereo_inertial.sh [--plslam PATH] [--seeds "31 32 33"] [--motions "handheld drone walk"]
+#                            [--frames N] [--blackout S] OUT
+#
+# OUT/stereo_inertial.txt: one line per render. About 40 s per render and seed (two runs).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+plslam=build/plslam seeds="31 32 33" motions="handheld drone walk" frames=480 blackout=-1
+while [ $# -gt 1 ]; do
+  case "$1" in
+    --plslam) plslam=$2; shift 2 ;;
+    --seeds) seeds=$2; shift 2 ;;
+    --motions) motions=$2; shift 2 ;;
+    --frames) frames=$2; shift 2 ;;
+    --blackout) blackout=$2; shift 2 ;;
+    *) echo "stereo_inertial.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+out=${1:?usage: bench/stereo_inertial.sh [--plslam PATH] [--seeds LIST] [--motions LIST] [--frames N] [--blackout S] OUT}
+plslam=$(realpath "$plslam")
+mkdir -p "$out"
+out=$(realpath "$out")
+table="$out/stereo_inertial.txt"
+: > "$table"
+# SEQ OUT: one run's figures from its stats.json.
+figures() {
+  /usr/bin/python3 - "$1/stats.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+imu = (s.get("imu") or {}).get("slam") or {}
+ate = s.get("accuracy", {}).get("ape_trans_m", {}).get("rmse", float("nan"))
+print(f"{ate:.4f} tracked {s['tracked_frames']} lost {s['lost_events']} reloc {len(s['relocalizations'])} "
+      f"segments {s['new_map_segments']} imu {imu.get('imu_tracked_frames', 0)} inertial {imu.get('inertial_frames', 0)}")
+PY
+}
+for motion in $motions; do
+  for seed in $seeds; do
+    seq="$out/office_${motion}_$seed"
+    [ -f "$seq/mav0/synth/synth.json" ] ||
+      "$plslam" synth --out "$seq" --force --scene office --preset euroc --frames "$frames" --loop --seed "$seed" \
+        --motion "$motion" --imu-noise euroc > /dev/null 2>&1
+    input=$seq
+    if [ "$blackout" -ge 0 ]; then
+      input="$seq.blackout$blackout"
+      rm -rf "$input"
+      cp -rs "$seq" "$input"
+      /usr/bin/python3 - "$input" "$blackout" <<'PY'
+import os, struct, sys, zlib
+root, start = sys.argv[1], int(sys.argv[2])
+def black_png(path, width, height):
+    chunk = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
+    raw = b''.join(b'\x00' + bytes(width) for _ in range(height))
+    with open(path, 'wb') as f:
+        f.write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', width, height, 8, 0, 0, 0, 0))
+                + chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))
+for cam in ('cam0', 'cam1'):
+    folder = f'{root}/mav0/{cam}/data'
+    names = sorted(os.listdir(folder), key=lambda n: int(n.split('.')[0]))
+    with open(os.path.join(folder, names[0]), 'rb') as f:
+        width, height = struct.unpack('>II', f.read(24)[16:24])
+    for name in names[start:start + 20]:
+        os.remove(f'{folder}/{name}')
+        black_png(f'{folder}/{name}', width, height)
+PY
+    fi
+    "$plslam" run "$input" --out "$out/vi_${motion}_$seed" --quiet > /dev/null 2>&1 || true
+    "$plslam" run "$input" --out "$out/vo_${motion}_$seed" --quiet --no-imu > /dev/null 2>&1 || true
+    vi=$(figures "$out/vi_${motion}_$seed")
+    vo=$(figures "$out/vo_${motion}_$seed")
+    ratio=$(/usr/bin/python3 -c "import sys; a, b = float(sys.argv[1]), float(sys.argv[2]); print(f'{a / b:.2f}')" \
+      "${vi%% *}" "${vo%% *}")
+    echo "$motion seed $seed | stereo-inertial $vi | stereo $vo | ratio $ratio" | tee -a "$table"
+  done
+done

@@ -1,0 +1,188 @@
+// The tracker's use of the IMU once the map is gravity-aligned: the IMU chain's start, the IMU's
+// prediction of each frame from the last keyframe's estimated state, the pose optimisation with
+// the IMU's residual, the frames the IMU carries alone, and the state each new keyframe starts with.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "plslam/geometry/stereo_camera.h"
+#include "plslam/tracking/projection_search.h"
+#include "plslam/tracking/tracker.h"
+
+namespace plslam::tracking {
+namespace {
+
+// The IMU's motion from t_i to t_j at `bias`; null when the samples do not cover it.
+std::shared_ptr<const inertial::Preintegration> preintegrate(const ImuData& imu, double t_i, double t_j,
+                                                             const inertial::ImuBias& bias) {
+  try {
+    return std::make_shared<const inertial::Preintegration>(imu.samples, t_i, t_j, bias, imu.calibration.noise);
+  } catch (const std::invalid_argument& e) {
+    spdlog::debug("no IMU motion from {:.3f} to {:.3f} s: {}", t_i, t_j, e.what());
+    return nullptr;
+  }
+}
+
+}  // namespace
+
+void Tracker::use_imu(const ImuData& imu, const inertial::ImuBias& bias) {
+  imu_ = &imu;
+  T_imu_cam_ = geometry::SE3(imu.T_imu_cam.linear(), imu.T_imu_cam.translation());
+  last_bias_ = bias;
+  if (!last_keyframe_ || last_keyframe_->is_bad()) return;
+  // The chain starts with the last keyframes of the current segment, in time order.
+  std::vector<map::KeyFrame*> chain;
+  for (map::KeyFrame* kf : map_.keyframes()) {
+    if (kf->segment() == last_keyframe_->segment() && kf->id() <= last_keyframe_->id()) chain.push_back(kf);
+  }
+  const auto n = static_cast<std::size_t>(std::max(1, options_.imu.seed_keyframes));
+  if (chain.size() > n) chain.erase(chain.begin(), chain.end() - static_cast<std::ptrdiff_t>(n));
+  const geometry::SE3 T_cam_imu = T_imu_cam_.inverse();
+  std::vector<Eigen::Vector3d> p;
+  for (const auto* kf : chain) p.push_back((kf->pose_inverse() * T_cam_imu).translation());
+  for (std::size_t k = 0; k < chain.size(); ++k) {
+    // Central differences of the body's positions: a seed that local BA replaces.
+    const std::size_t a = k == 0 ? 0 : k - 1, b = std::min(k + 1, chain.size() - 1);
+    map::KeyFrameImu s;
+    if (b > a) s.v = (p[b] - p[a]) / (chain[b]->timestamp() - chain[a]->timestamp());
+    s.bias = bias;
+    if (k > 0) {
+      s.from_previous = preintegrate(imu, chain[k - 1]->timestamp(), chain[k]->timestamp(), bias);
+      if (s.from_previous) s.previous = chain[k - 1];
+    }
+    chain[k]->set_imu(s);
+  }
+  imu_chain_live_ = state_ == TrackingState::kOk;
+  spdlog::info("imu: tracking with the IMU from here on; its chain starts with {} keyframes", chain.size());
+}
+
+std::optional<Tracker::ImuPrior> Tracker::imu_prior(const Frame& f) const {
+  if (!imu_ || !imu_chain_live_ || recovery_ || !last_keyframe_ || last_keyframe_->is_bad()) return std::nullopt;
+  const double t = f.data->timestamp;
+  // The newest keyframe of the chain that a local BA estimated.
+  const map::KeyFrame* kf = last_keyframe_;
+  std::optional<map::KeyFrameImu> state = kf->imu();
+  while (state && !state->estimated && state->previous) {
+    kf = state->previous;
+    state = kf->imu();
+  }
+  if (!state || !state->estimated || t - kf->timestamp() > options_.imu.max_prediction_s) return std::nullopt;
+  const double t_kf = kf->timestamp();
+  if (!(t > t_kf)) return std::nullopt;
+  ImuPrior prior;
+  prior.keyframe = kf;
+  prior.pim = preintegrate(*imu_, t_kf, t, state->bias);
+  if (!prior.pim) return std::nullopt;
+  prior.from = {kf->pose_inverse() * T_imu_cam_.inverse(), state->v, state->bias};
+  prior.predicted = inertial::predict(prior.from, *prior.pim);
+  prior.T_cw = (prior.predicted.T_wb * T_imu_cam_).inverse().normalized();
+  return prior;
+}
+
+map::KeyFrameImu Tracker::keyframe_imu(const Frame& f) const {
+  map::KeyFrameImu s;
+  if (f.imu) {
+    s.v = f.imu->v;
+    s.bias = f.imu->bias;
+  } else {
+    // Tracked without the IMU (the chain's last state not estimated yet): a seed from the last
+    // frame's motion, for local BA to estimate.
+    s.bias = last_bias_;
+    if (last_ && f.data->timestamp > last_->data->timestamp) {
+      const geometry::SE3 T_cam_imu = T_imu_cam_.inverse();
+      s.v = ((f.T_cw.inverse() * T_cam_imu).translation() - (last_->T_cw.inverse() * T_cam_imu).translation()) /
+            (f.data->timestamp - last_->data->timestamp);
+    }
+  }
+  map::KeyFrame* previous = last_keyframe_;
+  if (imu_chain_live_ && previous && !previous->is_bad()) {
+    if (const auto before = previous->imu()) {
+      s.from_previous = preintegrate(*imu_, previous->timestamp(), f.data->timestamp, before->bias);
+      if (s.from_previous) s.previous = previous;
+    }
+  }
+  return s;
+}
+
+int Tracker::optimize_pose_inertial(Frame& f, const std::vector<optim::PosePointTerm>& points,
+                                    const std::vector<optim::PoseLineTerm>& lines,
+                                    const optim::PoseOnlyOptions& options) {
+  const inertial::InertialTerms terms(*prior_->pim, prior_->from, T_imu_cam_);
+  const Eigen::Vector3d v0 = f.imu ? f.imu->v : prior_->predicted.v;
+  const inertial::ImuBias b0 = f.imu ? f.imu->bias : prior_->from.bias;
+  const auto r = inertial::optimize_pose_inertial(geometry::StereoCamera(f.data->calib), terms, f.T_cw, v0, b0, points,
+                                                  lines, options);
+  f.T_cw = r.visual.T_cw.normalized();
+  f.imu = Frame::Imu{r.state.v, r.state.bias};
+  f.pose_covariance = r.visual.covariance;
+  for (std::size_t k = 0, i = 0; i < f.points.size(); ++i) {
+    if (f.points[i]) f.point_outlier[i] = r.visual.point_outlier[k++];
+  }
+  for (std::size_t k = 0, j = 0; j < f.lines.size(); ++j) {
+    if (f.lines[j]) f.line_outlier[j] = r.visual.line_outlier[k++];
+  }
+  return r.visual.num_point_inliers + r.visual.num_line_inliers;
+}
+
+bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
+  if (!prior_) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  f.T_cw = prior_->T_cw;
+  std::fill(f.points.begin(), f.points.end(), nullptr);
+  std::fill(f.lines.begin(), f.lines.end(), nullptr);
+  // Keyframes near the predicted camera, looking within 45 deg of its direction, nearest first.
+  const Eigen::Vector3d centre = f.camera_center();
+  const Eigen::Vector3d axis = f.T_cw.rotation().row(2).transpose();
+  std::vector<std::pair<double, map::KeyFrame*>> near;
+  for (map::KeyFrame* kf : map_.keyframes()) {
+    if (kf->is_bad() || !map_.anchored(kf->segment())) continue;
+    const Eigen::Vector3d kf_axis = kf->pose().rotation().row(2).transpose();
+    if (axis.dot(kf_axis) < std::cos(M_PI / 4)) continue;
+    near.emplace_back((kf->camera_center() - centre).norm(), kf);
+  }
+  const std::size_t n = std::min(near.size(), static_cast<std::size_t>(options_.local_map_covisibles));
+  std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end(),
+                    [](const auto& a, const auto& b) { return a.first < b.first || (a.first == b.first && a.second->id() < b.second->id()); });
+  std::vector<map::MapPoint*> points;
+  std::vector<map::MapLine*> lines;
+  core::PointerSet seen_p, seen_l;
+  seen_p.assign(f.points, 0);
+  seen_l.assign(f.lines, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    for (auto* mp : near[k].second->map_points()) {
+      if (mp && !mp->is_bad() && seen_p.insert(mp)) points.push_back(mp);
+    }
+    if (!options_.lines) continue;
+    for (auto* ml : near[k].second->map_lines()) {
+      if (ml && !ml->is_bad() && seen_l.insert(ml)) lines.push_back(ml);
+    }
+  }
+  int found = search_points_in_local_map(f, points, options_.motion_retry_scale * options_.local_map_radius, options_.search);
+  if (options_.lines) found += search_lines(f, lines, options_.motion_retry_scale * options_.line_radius, options_.search);
+  int inliers = 0;
+  if (found >= options_.min_motion_matches) inliers = optimize_pose(f, t);
+  f.discard_outliers();
+  t.track_motion_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  spdlog::debug("frame {}: {} matches in {} keyframes near the IMU's prediction, {} inliers", f.id(), found, n, inliers);
+  return inliers >= options_.min_pose_inliers;
+}
+
+bool Tracker::carry_by_imu(Frame& f) {
+  if (!prior_ || !last_visual_t_ || f.data->timestamp - *last_visual_t_ > options_.imu.max_inertial_s) return false;
+  int stereo = 0;
+  for (const float z : f.data->depth) stereo += z > 0;
+  if (stereo >= options_.imu.max_texture_points) return false;
+  std::fill(f.points.begin(), f.points.end(), nullptr);
+  std::fill(f.lines.begin(), f.lines.end(), nullptr);
+  f.T_cw = prior_->T_cw;
+  f.imu = Frame::Imu{prior_->predicted.v, prior_->predicted.bias};
+  f.pose_covariance.setZero();
+  f.reference = reference_;
+  ++inertial_frames_;
+  return true;
+}
+
+}  // namespace plslam::tracking
