@@ -36,8 +36,9 @@ import json, sys
 s = json.load(open(sys.argv[1]))
 imu = (s.get("imu") or {}).get("slam") or {}
 ate = s.get("accuracy", {}).get("ape_trans_m", {}).get("rmse", float("nan"))
-print(f"{ate:.4f} tracked {s['tracked_frames']} lost {s['lost_events']} reloc {len(s['relocalizations'])} "
-      f"segments {s['new_map_segments']} imu {imu.get('imu_tracked_frames', 0)} inertial {imu.get('inertial_frames', 0)}")
+count = lambda v: v["count"] if isinstance(v, dict) else len(v) if isinstance(v, list) else v
+print(f"{ate:.4f} tracked {s['tracked_frames']} lost {s['lost_events']} reloc {count(s['relocalizations'])} "
+      f"segments {count(s['new_map_segments'])} imu {imu.get('imu_tracked_frames', 0)} inertial {imu.get('inertial_frames', 0)}")
 PY
 }
 for motion in $motions; do

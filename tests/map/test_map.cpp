@@ -545,6 +545,14 @@ TEST(KeyFrameImu, BaEstimatesAndTheWorldsTurn) {
   map.transform_world(T);
   EXPECT_LT((kf->imu()->v - Eigen::Vector3d(-1, 0, 0)).norm(), 1e-12);  // turns, does not move
   EXPECT_EQ(kf->imu()->bias.acc, Eigen::Vector3d(0, 0, 0.2));          // the body's: unchanged
+  // A loop correction that turns the keyframe's camera by 90 deg about z turns its velocity too;
+  // BA's set_pose does not (it estimates the velocity itself).
+  const geometry::SE3 turned =
+      kf->pose() * geometry::SE3(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix(), Eigen::Vector3d(1, 2, 3));
+  kf->move_to(turned);
+  EXPECT_LT((kf->imu()->v - Eigen::Vector3d(0, -1, 0)).norm(), 1e-12);
+  kf->set_pose(geometry::SE3());
+  EXPECT_LT((kf->imu()->v - Eigen::Vector3d(0, -1, 0)).norm(), 1e-12);
 }
 
 }  // namespace

@@ -70,7 +70,7 @@ GlobalBaMergeStats merge_global_ba(map::Map& map, const GlobalBaSnapshot& s, con
     after[kf] = (before.at(kf) * before.at(anchor).inverse() * after.at(anchor)).normalized();
     ++st.propagated_keyframes;
   }
-  for (const auto& [kf, T] : after) kf->set_pose(T);
+  for (const auto& [kf, T] : after) kf->move_to(T);
 
   // Landmarks: the BA's positions; the ones made since move with their reference keyframe.
   map::IdSet<map::MapPoint> optimised_points(p.points.begin(), p.points.end());

@@ -92,7 +92,7 @@ LoopCorrectionPlan begin_loop_correction(map::Map& map, const LoopConstraint& lo
       if (!l || l->is_bad() || !line_corrected_by.emplace(l, kf).second) continue;
       l->set_endpoints(M * l->start(), M * l->end());
     }
-    kf->set_pose(graph.initial.at(kf));
+    kf->move_to(graph.initial.at(kf));
   }
 
   // 3. Fusion: the verified matches, then the place's landmarks projected into the neighbourhood.
@@ -207,7 +207,7 @@ LoopCorrectionResult finish_loop_correction(map::Map& map, LoopCorrectionPlan& p
     after[kf] = (now * motion.inverse()).normalized();
     ++r.unmapped_keyframes;
   }
-  for (const auto& [kf, T] : after) kf->set_pose(T);
+  for (const auto& [kf, T] : after) kf->move_to(T);
   // A landmark's anchor moved from `before` to `after`; it keeps its place in the anchor's camera frame.
   auto motion_of = [&](KeyFrame* anchor) { return (after.at(anchor).inverse() * before.at(anchor)).normalized(); };
   const auto& point_corrected_by = plan.point_corrected_by;

@@ -241,6 +241,12 @@ IdSet<KeyFrame> KeyFrame::loop_edges() const {
   return loop_edges_;
 }
 
+void KeyFrame::move_to(const geometry::SE3& T_cw) {
+  const Eigen::Matrix3d R_before = pose().rotation();
+  set_pose(T_cw);
+  rotate_imu_velocity(pose().rotation().transpose() * R_before);  // R_wc_new R_wc_old'
+}
+
 bool KeyFrame::has_imu() const {
   std::lock_guard lock(imu_mutex_);
   return imu_.has_value();

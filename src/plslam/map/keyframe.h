@@ -62,6 +62,9 @@ class KeyFrame {
   geometry::SE3 pose_inverse() const;  // T_wc
   Eigen::Vector3d camera_center() const;
   void set_pose(const geometry::SE3& T_cw);
+  // A correction that moves the keyframe with its surroundings (loop correction, global BA): its
+  // IMU velocity turns as its camera does.
+  void move_to(const geometry::SE3& T_cw);
 
   // Point associations, indexed like data().keypoints.
   void add_map_point(MapPoint* p, int index);
