@@ -27,6 +27,7 @@ while [ $# -gt 1 ]; do
 done
 out=${1:?usage: bench/blackout_sweep.sh [--plslam PATH] [--starts LIST] [--frames N] [--jobs J] OUT}
 plslam=$(realpath "$plslam")
+lib=$(realpath bench/lib/aliasing.py)
 mkdir -p "$out/work"
 out=$(realpath "$out")
 office="$out/office"
@@ -39,24 +40,7 @@ one() {
   rm -rf "$w" "$w.out"
   cp -rs "$office" "$w"
   if [ "$start" -ge 0 ]; then
-    python3 - "$w" "$start" <<'PY'
-import os, struct, sys, zlib
-root, start = sys.argv[1], int(sys.argv[2])
-def black_png(path, width, height):
-    chunk = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
-    raw = b''.join(b'\x00' + bytes(width) for _ in range(height))
-    with open(path, 'wb') as f:
-        f.write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', width, height, 8, 0, 0, 0, 0))
-                + chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))
-for cam in ('cam0', 'cam1'):
-    folder = f'{root}/mav0/{cam}/data'
-    names = sorted(os.listdir(folder), key=lambda n: int(n.split('.')[0]))  # by time, not by name
-    with open(os.path.join(folder, names[0]), 'rb') as f:
-        width, height = struct.unpack('>II', f.read(24)[16:24])
-    for name in names[start:start + 20]:
-        os.remove(f'{folder}/{name}')
-        black_png(f'{folder}/{name}', width, height)
-PY
+    python3 "$lib" blackout "$w" "$start" 20
   fi
   "$plslam" run "$w" --out "$w.out" --sequential --quiet >/dev/null 2>&1 || true
   python3 - "$w.out/stats.json" "$start" <<'PY'
@@ -72,7 +56,7 @@ print(sys.argv[2], "relocalized", s["relocalizations"]["frames"] or "-", "segmen
 PY
 }
 export -f one
-export out office plslam
+export out office plslam lib
 printf '%s\n' -1 $starts | xargs -P "$jobs" -I{} bash -c 'one {}' | sort -n > "$out/sweep.txt"
 python3 - "$out/sweep.txt" <<'PY' | tee "$out/summary.txt"
 import sys

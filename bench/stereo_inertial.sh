@@ -52,24 +52,7 @@ for motion in $motions; do
       input="$seq.blackout$blackout"
       rm -rf "$input"
       cp -rs "$seq" "$input"
-      /usr/bin/python3 - "$input" "$blackout" <<'PY'
-import os, struct, sys, zlib
-root, start = sys.argv[1], int(sys.argv[2])
-def black_png(path, width, height):
-    chunk = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d) & 0xffffffff)
-    raw = b''.join(b'\x00' + bytes(width) for _ in range(height))
-    with open(path, 'wb') as f:
-        f.write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', width, height, 8, 0, 0, 0, 0))
-                + chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))
-for cam in ('cam0', 'cam1'):
-    folder = f'{root}/mav0/{cam}/data'
-    names = sorted(os.listdir(folder), key=lambda n: int(n.split('.')[0]))
-    with open(os.path.join(folder, names[0]), 'rb') as f:
-        width, height = struct.unpack('>II', f.read(24)[16:24])
-    for name in names[start:start + 20]:
-        os.remove(f'{folder}/{name}')
-        black_png(f'{folder}/{name}', width, height)
-PY
+      python3 bench/lib/aliasing.py blackout "$input" "$blackout" 20
     fi
     "$plslam" run "$input" --out "$out/vi_${motion}_$seed" --quiet > /dev/null 2>&1 || true
     "$plslam" run "$input" --out "$out/vo_${motion}_$seed" --quiet --no-imu > /dev/null 2>&1 || true

@@ -5,6 +5,10 @@
                                   "A-B" and black runs "Bn" (n black frames); frames get new,
                                   evenly spaced times at the source's rate, and the ground truth
                                   follows them (images are linked, black ones written)
+  aliasing.py blackout SEQ START N
+                                  in an EuRoC-layout SEQ (a linked copy: `cp -rs`), frames
+                                  START..START+N-1 of both cameras replaced by black images; the
+                                  times, the ground truth and the IMU stay as they are
   aliasing.py back SEQ FRAME METRES
                                   the frame before FRAME whose camera is METRES behind it along
                                   the path (a place one or more repetitions of the scene back)
@@ -203,6 +207,16 @@ def cmd_copy(src, dst, plan):
                 f.write(f"{t:.9f} {rows[key(s)]}\n")
 
 
+def cmd_blackout(seq, start, n):
+    for cam in ("cam0", "cam1"):
+        folder = os.path.join(seq, "mav0", cam, "data")
+        names = sorted(os.listdir(folder), key=lambda name: int(name.split(".")[0]))  # by time, not by name
+        width, height = png_size(os.path.join(folder, names[0]))
+        for name in names[start:start + n]:
+            os.remove(os.path.join(folder, name))
+            black_png(os.path.join(folder, name), width, height)
+
+
 def cmd_back(seq, frame, metres):
     poses = read_tum(os.path.join(synth_dir(seq), "left_camera.tum"))
     travelled = 0.0
@@ -256,6 +270,8 @@ if __name__ == "__main__":
     a = sys.argv[1:]
     if len(a) == 4 and a[0] == "copy":
         cmd_copy(a[1], a[2], a[3])
+    elif len(a) == 4 and a[0] == "blackout":
+        cmd_blackout(a[1], int(a[2]), int(a[3]))
     elif len(a) == 4 and a[0] == "back":
         cmd_back(a[1], int(a[2]), float(a[3]))
     elif len(a) == 4 and a[0] == "eval":
