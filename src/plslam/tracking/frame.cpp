@@ -1,5 +1,7 @@
 #include "plslam/tracking/frame.h"
 
+#include <algorithm>
+
 #include "plslam/map/map_line.h"
 #include "plslam/map/map_point.h"
 
@@ -17,6 +19,17 @@ int Frame::num_matched_lines() const {
   int n = 0;
   for (std::size_t i = 0; i < lines.size(); ++i) n += lines[i] && !line_outlier[i] && !lines[i]->is_bad();
   return n;
+}
+
+int Frame::num_stereo_points() const {
+  int n = 0;
+  for (const float z : data->depth) n += z > 0;
+  return n;
+}
+
+void Frame::clear_matches() {
+  std::fill(points.begin(), points.end(), nullptr);
+  std::fill(lines.begin(), lines.end(), nullptr);
 }
 
 void Frame::discard_outliers() {

@@ -45,6 +45,10 @@ struct Frame {
   Eigen::Vector3d camera_center() const { return T_cw.inverse().translation(); }
   int num_matched_points() const;
   int num_matched_lines() const;
+  // Keypoints with a stereo depth (what starting a map needs, and what a textureless image lacks).
+  int num_stereo_points() const;
+  // Forgets every point and line association.
+  void clear_matches();
   // Drops the associations flagged as outliers (after pose optimisation).
   void discard_outliers();
 };

@@ -200,10 +200,6 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   bool inertial = false;
 
   bool ok = false;
-  auto clear_matches = [&f] {
-    std::fill(f.points.begin(), f.points.end(), nullptr);
-    std::fill(f.lines.begin(), f.lines.end(), nullptr);
-  };
   if (state_ == TrackingState::kNotInitialized) {
     ok = initialize(f);
     if (ok) {
@@ -213,7 +209,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   } else if (state_ == TrackingState::kLost) {
     ok = relocalize_and_track(f, result);
     if (!ok) {
-      clear_matches();
+      f.clear_matches();
       // A new map segment starts where the motion model puts the camera, so the trajectory stays
       // continuous across the loss.
       f.T_cw = predicted_pose(f);
@@ -293,10 +289,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
         last_bias_ = f.imu->bias;
         ++imu_tracked_frames_;
       }
-    } else if (prior_ && (spdlog::debug("frame {}: vision failed; the IMU predicts it from keyframe {}, {:.2f} s earlier, at ({:.3f} {:.3f} {:.3f})",
-                                        f.id(), prior_->keyframe->id(), prior_->pim->dt(), prior_->T_cw.inverse().translation().x(),
-                                        prior_->T_cw.inverse().translation().y(), prior_->T_cw.inverse().translation().z()),
-                          !recovery_ && carry_by_imu(f))) {
+    } else if (!recovery_ && carry_by_imu(f)) {
       ok = true;
       inertial = true;
     } else {
@@ -316,7 +309,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
         // The motion model's prediction: where a new map segment would start. It is not a tracked
         // pose (the record says so), and the trajectory outputs never present it as one.
         f.T_cw = predicted_pose(f);
-        clear_matches();
+        f.clear_matches();
       }
     }
   }
@@ -441,11 +434,7 @@ void Tracker::finish_tracked_frame(Frame& f, TrackResult& result) {
   f.discard_outliers();
 }
 
-bool Tracker::can_start_map(const Frame& f) const {
-  int stereo = 0;
-  for (float z : f.data->depth) stereo += z > 0;
-  return stereo >= options_.init_min_points;
-}
+bool Tracker::can_start_map(const Frame& f) const { return f.num_stereo_points() >= options_.init_min_points; }
 
 bool Tracker::should_start_new_segment(const Frame& f) {
   if (options_.localization_only) return false;
@@ -471,8 +460,7 @@ bool Tracker::initialize(Frame& f) {
     }
   }
   if (imu_) {
-    imu_chain_live_ = false;  // a new segment: a new chain
-    kf->set_imu(keyframe_imu(f));
+    kf->set_imu(keyframe_imu(f, /*chained=*/false));  // a new segment: a new chain
     imu_chain_live_ = true;
   }
   f.reference = kf;
@@ -520,12 +508,7 @@ int Tracker::optimize_pose(Frame& f, TrackStageTimes& t, bool covariance) {
   auto popts = options_.pose;
   popts.scale_factor = d.scale_factor;
   popts.covariance = covariance;
-  if (prior_) {
-    const int inliers = optimize_pose_inertial(f, pts, lns, popts);
-    t.pose_optimization_ms += ms_since(t0);
-    return inliers;
-  }
-  const auto r = optim::optimize_pose(cam, f.T_cw, pts, lns, popts);
+  const auto r = prior_ ? optimize_pose_inertial(f, pts, lns, popts) : optim::optimize_pose(cam, f.T_cw, pts, lns, popts);
   f.T_cw = r.T_cw.normalized();
   f.pose_covariance = r.covariance;
   for (std::size_t k = 0; k < pidx.size(); ++k) f.point_outlier[pidx[k]] = r.point_outlier[k];
@@ -547,8 +530,7 @@ bool Tracker::track_with_motion_model(Frame& f, TrackStageTimes& t) {
   // the normal windows, then optimise. Returns the matches found; `inliers` is 0 when too few.
   auto attempt = [&](double scale, int& inliers) {
     f.T_cw = predicted;
-    std::fill(f.points.begin(), f.points.end(), nullptr);
-    std::fill(f.lines.begin(), f.lines.end(), nullptr);
+    f.clear_matches();
     int n = search_points_from_frame(f, *last_, scale * options_.motion_radius, options_.search);
     if (options_.lines) n += search_lines(f, last_lines, scale * options_.line_radius, options_.search);
     inliers = n >= options_.min_motion_matches ? optimize_pose(f, t) : 0;
@@ -576,10 +558,7 @@ bool Tracker::track_with_motion_model(Frame& f, TrackStageTimes& t) {
   }
   f.discard_outliers();
   const bool ok = inliers >= options_.min_pose_inliers;
-  if (!ok) {
-    std::fill(f.points.begin(), f.points.end(), nullptr);
-    std::fill(f.lines.begin(), f.lines.end(), nullptr);
-  }
+  if (!ok) f.clear_matches();
   t.track_motion_ms += ms_since(t0);
   return ok;
 }
@@ -818,7 +797,7 @@ map::KeyFrame* Tracker::create_keyframe(Frame& f) {
     }
   }
   if (imu_) {
-    kf->set_imu(keyframe_imu(f));
+    kf->set_imu(keyframe_imu(f, imu_chain_live_));
     imu_chain_live_ = true;
   }
   reference_ = kf;

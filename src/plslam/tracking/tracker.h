@@ -310,11 +310,12 @@ class Tracker {
     geometry::SE3 T_cw;  // the camera's predicted pose
   };
   std::optional<ImuPrior> imu_prior(const Frame& f) const;
-  // The IMU state a keyframe made from `f` starts with, chained to the last keyframe's.
-  map::KeyFrameImu keyframe_imu(const Frame& f) const;
-  // optimize_pose with the IMU's residual from prior_ (f.imu gets the velocity and biases).
-  int optimize_pose_inertial(Frame& f, const std::vector<optim::PosePointTerm>& points,
-                             const std::vector<optim::PoseLineTerm>& lines, const optim::PoseOnlyOptions& options);
+  // The IMU state a keyframe made from `f` starts with; `chained`: linked to the last keyframe's.
+  map::KeyFrameImu keyframe_imu(const Frame& f, bool chained) const;
+  // optim::optimize_pose with the IMU's residual from prior_ (f.imu gets the velocity and biases).
+  optim::PoseOnlyResult optimize_pose_inertial(Frame& f, const std::vector<optim::PosePointTerm>& points,
+                                               const std::vector<optim::PoseLineTerm>& lines,
+                                               const optim::PoseOnlyOptions& options);
   // A frame vision could not track, within max_inertial_s of the last it did: the IMU's pose.
   bool carry_by_imu(Frame& f);
   // After a gap the last frame's matches and the reference keyframe may be out of view: the map

@@ -8,6 +8,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "plslam/core/stopwatch.h"
 #include "plslam/geometry/stereo_camera.h"
 #include "plslam/tracking/projection_search.h"
 #include "plslam/tracking/tracker.h"
@@ -30,7 +31,7 @@ std::shared_ptr<const inertial::Preintegration> preintegrate(const ImuData& imu,
 
 void Tracker::use_imu(const ImuData& imu, const inertial::ImuBias& bias) {
   imu_ = &imu;
-  T_imu_cam_ = geometry::SE3(imu.T_imu_cam.linear(), imu.T_imu_cam.translation());
+  T_imu_cam_ = geometry::SE3(imu.T_imu_cam);
   last_bias_ = bias;
   if (!last_keyframe_ || last_keyframe_->is_bad()) return;
   // The chain starts with the last keyframes of the current segment, in time order.
@@ -82,7 +83,7 @@ std::optional<Tracker::ImuPrior> Tracker::imu_prior(const Frame& f) const {
   return prior;
 }
 
-map::KeyFrameImu Tracker::keyframe_imu(const Frame& f) const {
+map::KeyFrameImu Tracker::keyframe_imu(const Frame& f, bool chained) const {
   map::KeyFrameImu s;
   if (f.imu) {
     s.v = f.imu->v;
@@ -98,7 +99,7 @@ map::KeyFrameImu Tracker::keyframe_imu(const Frame& f) const {
     }
   }
   map::KeyFrame* previous = last_keyframe_;
-  if (imu_chain_live_ && previous && !previous->is_bad()) {
+  if (chained && previous && !previous->is_bad()) {
     if (const auto before = previous->imu()) {
       s.from_previous = preintegrate(*imu_, previous->timestamp(), f.data->timestamp, before->bias);
       if (s.from_previous) s.previous = previous;
@@ -107,32 +108,23 @@ map::KeyFrameImu Tracker::keyframe_imu(const Frame& f) const {
   return s;
 }
 
-int Tracker::optimize_pose_inertial(Frame& f, const std::vector<optim::PosePointTerm>& points,
-                                    const std::vector<optim::PoseLineTerm>& lines,
-                                    const optim::PoseOnlyOptions& options) {
+optim::PoseOnlyResult Tracker::optimize_pose_inertial(Frame& f, const std::vector<optim::PosePointTerm>& points,
+                                                      const std::vector<optim::PoseLineTerm>& lines,
+                                                      const optim::PoseOnlyOptions& options) {
   const inertial::InertialTerms terms(*prior_->pim, prior_->from, T_imu_cam_);
   const Eigen::Vector3d v0 = f.imu ? f.imu->v : prior_->predicted.v;
   const inertial::ImuBias b0 = f.imu ? f.imu->bias : prior_->from.bias;
-  const auto r = inertial::optimize_pose_inertial(geometry::StereoCamera(f.data->calib), terms, f.T_cw, v0, b0, points,
-                                                  lines, options);
-  f.T_cw = r.visual.T_cw.normalized();
+  auto r = inertial::optimize_pose_inertial(geometry::StereoCamera(f.data->calib), terms, f.T_cw, v0, b0, points, lines,
+                                            options);
   f.imu = Frame::Imu{r.state.v, r.state.bias};
-  f.pose_covariance = r.visual.covariance;
-  for (std::size_t k = 0, i = 0; i < f.points.size(); ++i) {
-    if (f.points[i]) f.point_outlier[i] = r.visual.point_outlier[k++];
-  }
-  for (std::size_t k = 0, j = 0; j < f.lines.size(); ++j) {
-    if (f.lines[j]) f.line_outlier[j] = r.visual.line_outlier[k++];
-  }
-  return r.visual.num_point_inliers + r.visual.num_line_inliers;
+  return std::move(r.visual);
 }
 
 bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
   if (!prior_) return false;
   const auto t0 = std::chrono::steady_clock::now();
   f.T_cw = prior_->T_cw;
-  std::fill(f.points.begin(), f.points.end(), nullptr);
-  std::fill(f.lines.begin(), f.lines.end(), nullptr);
+  f.clear_matches();
   // Keyframes near the predicted camera, looking within 45 deg of its direction, nearest first.
   const Eigen::Vector3d centre = f.camera_center();
   const Eigen::Vector3d axis = f.T_cw.rotation().row(2).transpose();
@@ -165,18 +157,19 @@ bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
   int inliers = 0;
   if (found >= options_.min_motion_matches) inliers = optimize_pose(f, t);
   f.discard_outliers();
-  t.track_motion_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  t.track_motion_ms += ms_since(t0);
   spdlog::debug("frame {}: {} matches in {} keyframes near the IMU's prediction, {} inliers", f.id(), found, n, inliers);
   return inliers >= options_.min_pose_inliers;
 }
 
 bool Tracker::carry_by_imu(Frame& f) {
-  if (!prior_ || !last_visual_t_ || f.data->timestamp - *last_visual_t_ > options_.imu.max_inertial_s) return false;
-  int stereo = 0;
-  for (const float z : f.data->depth) stereo += z > 0;
-  if (stereo >= options_.imu.max_texture_points) return false;
-  std::fill(f.points.begin(), f.points.end(), nullptr);
-  std::fill(f.lines.begin(), f.lines.end(), nullptr);
+  if (!prior_) return false;
+  const Eigen::Vector3d c = prior_->T_cw.inverse().translation();
+  spdlog::debug("frame {}: vision failed; the IMU predicts it from keyframe {}, {:.2f} s earlier, at ({:.3f} {:.3f} {:.3f})",
+                f.id(), prior_->keyframe->id(), prior_->pim->dt(), c.x(), c.y(), c.z());
+  if (!last_visual_t_ || f.data->timestamp - *last_visual_t_ > options_.imu.max_inertial_s) return false;
+  if (f.num_stereo_points() >= options_.imu.max_texture_points) return false;
+  f.clear_matches();
   f.T_cw = prior_->T_cw;
   f.imu = Frame::Imu{prior_->predicted.v, prior_->predicted.bias};
   f.pose_covariance.setZero();
