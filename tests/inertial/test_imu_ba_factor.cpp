@@ -121,9 +121,14 @@ TEST(ImuBaFactor, JacobianMatchesNumericDifferentiationOverBothKeyframes) {
   }
 }
 
+class VisualInertialBackends : public ::testing::TestWithParam<optim::BaBackend> {};
+INSTANTIATE_TEST_SUITE_P(Backends, VisualInertialBackends,
+                         ::testing::Values(optim::BaBackend::kSchurLM, optim::BaBackend::kCeres),
+                         [](const auto& info) { return info.param == optim::BaBackend::kSchurLM ? "SchurLM" : "Ceres"; });
+
 // Keyframes 0.2 s apart, the first held (pose, velocity, biases) as the keyframe before a local
 // window is; every other one starts 3-5 cm and ~1 deg off, 0.2 m/s off, with zero biases.
-TEST(VisualInertialBundleAdjustment, ConvergesToTheTrueStatesAndBiases) {
+TEST_P(VisualInertialBackends, ConvergeToTheTrueStatesAndBiases) {
   const Sequence s(8);
   optim::BaProblem p = s.problem();
   p.keyframes[0].fixed = true;
@@ -137,7 +142,9 @@ TEST(VisualInertialBundleAdjustment, ConvergesToTheTrueStatesAndBiases) {
     p.keyframe_extra[k].head<3>() += 0.12 * Eigen::Vector3d(g(rng), g(rng), g(rng));
     p.keyframe_extra[k].tail<6>().setZero();
   }
-  const auto r = optim::local_bundle_adjustment(s.cam, p, {});
+  optim::BaOptions options;
+  options.backend = GetParam();
+  const auto r = optim::local_bundle_adjustment(s.cam, p, options);
   ASSERT_TRUE(r.usable) << r.message;
   ASSERT_EQ(r.keyframe_extra.size(), p.keyframes.size());
   for (std::size_t k = 1; k < p.keyframes.size(); ++k) {
@@ -157,7 +164,7 @@ TEST(VisualInertialBundleAdjustment, ConvergesToTheTrueStatesAndBiases) {
   for (auto& kf : at_truth.keyframes) kf.fixed = true;
   const double truth_cost = optim::bundle_adjust(s.cam, at_truth, {}).initial_cost;
   EXPECT_GT(r.initial_cost, 1e3 * truth_cost);
-  EXPECT_LE(r.final_cost, truth_cost);
+  EXPECT_LE(r.final_cost, truth_cost * (1 + 1e-9));
 }
 
 // A keyframe with no observation at all (a black frame) between two that see: vision alone
@@ -185,13 +192,10 @@ TEST(VisualInertialBundleAdjustment, ImuPlacesAKeyframeThatSeesNothing) {
   EXPECT_GT(centre_error(rv.poses[2], truth), 0.1);
 }
 
-TEST(VisualInertialBundleAdjustment, RefusesWhatItCannotSolve) {
+TEST(VisualInertialBundleAdjustment, BadFactorsAreInputErrors) {
   const Sequence s(3);
   optim::BaProblem p = s.problem();
   p.keyframes[0].fixed = true;
-  optim::BaOptions ceres;
-  ceres.backend = optim::BaBackend::kCeres;
-  EXPECT_THROW(optim::bundle_adjust(s.cam, p, ceres), std::invalid_argument);
   optim::BaProblem no_extra = p;
   no_extra.keyframe_extra.pop_back();
   EXPECT_THROW(optim::bundle_adjust(s.cam, no_extra, {}), InputError);

@@ -232,7 +232,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   // With an IMU: visual-inertial initialisation, then a gravity-aligned world, tracking with the
   // IMU and its factors in local BA (stereo-inertial). --no-imu: stereo only.
   const ImuData* imu = ds && ds->imu() ? &*ds->imu() : input.camera_imu ? &*input.camera_imu : nullptr;
-  if (imu && !args.no_imu) slam.set_imu(*imu);
+  if (imu && !args.no_imu && options.use_input_imu) slam.set_imu(*imu);
   app::install_stop_signals();
   std::string fatal;
   const auto start = std::chrono::steady_clock::now();

@@ -28,6 +28,7 @@ EssentialGraphProblem build_essential_graph(const EssentialGraphInput& in, const
     g.fixed.push_back(kf == in.candidate);
   }
   if (!index.count(in.candidate) && !g.fixed.empty()) g.fixed.front() = true;  // some node must hold the gauge
+  g.four_dof = in.query && in.candidate && in.query->has_imu() && in.candidate->has_imu();
   std::set<std::pair<long, long>> linked;  // by ids, lower first
   auto add = [&](map::KeyFrame* a, map::KeyFrame* b, const map::IdMap<map::KeyFrame, geometry::SE3>& from) {
     const auto ia = index.find(a), ib = index.find(b);
@@ -64,6 +65,7 @@ EssentialGraphResult solve_essential_graph(const EssentialGraphProblem& g, const
   r.edges = static_cast<int>(g.edges.size());
   optim::PoseGraphOptions po;
   po.iterations = o.iterations;
+  po.four_dof = g.four_dof;
   const auto res = optim::optimize_pose_graph(g.poses, g.fixed, g.edges, po);
   r.usable = res.usable;
   r.initial_cost = res.initial_cost;

@@ -46,6 +46,9 @@ struct EssentialGraphProblem {
   std::vector<bool> fixed;
   std::vector<optim::PoseGraphEdge> edges;
   int loop_edges = 0;
+  // The loop's keyframes carry IMU states (a gravity-aligned visual-inertial map): the graph moves
+  // the keyframes by yaw and translation only (optim::PoseGraphOptions::four_dof).
+  bool four_dof = false;
 };
 
 // Reads the graph (parents, loop edges, covisibility weights); writes nothing to the map.

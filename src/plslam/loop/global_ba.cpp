@@ -27,6 +27,7 @@ GlobalBaSnapshot snapshot_for_global_ba(const map::Map& map, const GlobalBaOptio
     s.problem->add_keyframe(kf, has_origin ? kf->is_origin() : kf == keyframes.front());
   }
   s.problem->add_landmarks_of(keyframes);
+  if (o.T_imu_cam) s.problem->add_imu_factors(keyframes, *o.T_imu_cam, o.reintegration, /*add_missing=*/false);
   return s;
 }
 
@@ -71,6 +72,7 @@ GlobalBaMergeStats merge_global_ba(map::Map& map, const GlobalBaSnapshot& s, con
     ++st.propagated_keyframes;
   }
   for (const auto& [kf, T] : after) kf->move_to(T);
+  p.write_back_imu_states(r);  // after move_to: the BA's velocities replace the turned ones
 
   // Landmarks: the BA's positions; the ones made since move with their reference keyframe.
   map::IdSet<map::MapPoint> optimised_points(p.points.begin(), p.points.end());

@@ -6,8 +6,10 @@
 // landmarks) moves with its parent or reference keyframe through the spanning tree.
 #include <atomic>
 #include <memory>
+#include <optional>
 
 #include "plslam/map/map.h"
+#include "plslam/inertial/preintegration.h"
 #include "plslam/mapping/map_ba_problem.h"
 #include "plslam/optim/bundle_adjustment.h"
 
@@ -23,6 +25,11 @@ struct GlobalBaOptions {
   double line_information = 0.5;
   double far_stereo_baselines = 0;
   bool lines = true;
+  // A visual-inertial map (LoopCloser::use_imu): the IMU factors between consecutive keyframes of
+  // the IMU chain join the BA, with every keyframe's velocity and biases (the map's origin holds
+  // the gauge as before).
+  std::optional<geometry::SE3> T_imu_cam;
+  inertial::ReintegrationThresholds reintegration;
   void validate() const;
 };
 

@@ -157,6 +157,9 @@ class LoopCloser {
   // it did (resume() after). For Map::reclaim(), which needs every thread at rest.
   bool try_pause();
   void resume();
+  // The map is visual-inertial from now on: global BA keeps the IMU chain's factors. Call while
+  // paused with try_pause() (no global BA running).
+  void use_imu(const geometry::SE3& T_imu_cam) { options_.global_ba_options.T_imu_cam = T_imu_cam; }
   LoopClosingStats stats() const;
 
  private:

@@ -7,7 +7,6 @@
 #include <spdlog/spdlog.h>
 
 #include "plslam/geometry/stereo_camera.h"
-#include "plslam/inertial/imu_ba_factor.h"
 
 namespace plslam::mapping {
 namespace {
@@ -23,36 +22,6 @@ std::vector<map::KeyFrame*> imu_chain_before(map::KeyFrame& kf, int n) {
   }
   std::reverse(chain.begin(), chain.end());
   return chain;
-}
-
-// The IMU factors between consecutive keyframes of the window's chain (its first keyframe's
-// predecessor included, fixed), and every keyframe's extra state ([v; bg; ba], zero outside the
-// chain).
-void add_imu_factors(MapBaProblem& window, const std::vector<map::KeyFrame*>& chain, const LocalBaOptions& o) {
-  auto& p = window.problem;
-  p.keyframe_extra.assign(p.keyframes.size(), optim::Vector9d::Zero());
-  for (std::size_t k = 0; k < window.keyframes.size(); ++k) {
-    if (const auto imu = window.keyframes[k]->imu()) p.keyframe_extra[k] = inertial::ba_extra_state(imu->v, imu->bias);
-  }
-  for (map::KeyFrame* j : chain) {
-    const auto imu = j->imu();
-    if (!imu->previous || !imu->from_previous) continue;
-    const int i_index = window.add_keyframe(imu->previous, true);
-    if (static_cast<std::size_t>(i_index) >= p.keyframe_extra.size()) {
-      const auto before = imu->previous->imu();
-      p.keyframe_extra.push_back(before ? inertial::ba_extra_state(before->v, before->bias) : optim::Vector9d::Zero());
-    }
-    const inertial::ImuBias bias_i = inertial::bias_of(p.keyframe_extra[static_cast<std::size_t>(i_index)]);
-    const inertial::Preintegration* pim = imu->from_previous.get();
-    std::optional<inertial::Preintegration> again;
-    if (pim->bias_moved_far(bias_i, o.reintegration)) {
-      again.emplace(*pim);
-      again->reintegrate(bias_i);
-      pim = &*again;
-    }
-    p.keyframe_factors.push_back(
-        std::make_shared<inertial::ImuBaFactor>(i_index, window.add_keyframe(j, j->is_origin()), *pim, o.T_imu_cam));
-  }
 }
 
 }  // namespace
@@ -73,7 +42,7 @@ MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o,
   MapBaProblem window(o.line_information, o.far_stereo_baselines, o.lines);
   for (auto* k : local) window.add_keyframe(k, k->is_origin());
   window.add_landmarks_of(local);
-  if (chain.size() > 1 || (chain.size() == 1 && chain.front()->imu()->previous)) add_imu_factors(window, chain, o);
+  if (!chain.empty()) window.add_imu_factors(chain, o.T_imu_cam, o.reintegration, /*add_missing=*/true);
   return window;
 }
 
@@ -97,18 +66,10 @@ void write_back_local_ba(const MapBaProblem& window, const optim::BaResult& resu
     if (idx >= 0) k->erase_map_line(idx);
     ml->erase_observation(k);
   }
-  std::vector<bool> in_imu_factor(window.keyframes.size(), false);
-  for (const auto& f : problem.keyframe_factors) {
-    for (const int k : f->keyframes()) in_imu_factor[static_cast<std::size_t>(k)] = true;
-  }
   for (std::size_t i = 0; i < window.keyframes.size(); ++i) {
-    if (problem.keyframes[i].fixed) continue;
-    window.keyframes[i]->set_pose(result.poses[i]);
-    if (in_imu_factor[i] && window.keyframes[i]->has_imu()) {
-      window.keyframes[i]->set_imu_velocity_and_bias(inertial::velocity_of(result.keyframe_extra[i]),
-                                                     inertial::bias_of(result.keyframe_extra[i]));
-    }
+    if (!problem.keyframes[i].fixed) window.keyframes[i]->set_pose(result.poses[i]);
   }
+  window.write_back_imu_states(result);
   for (std::size_t p = 0; p < points.size(); ++p) {
     if (points[p]->is_bad()) continue;
     points[p]->set_position(result.points[p]);

@@ -1,6 +1,9 @@
 #include "plslam/mapping/map_ba_problem.h"
 
+#include <optional>
+
 #include "plslam/core/pointer_set.h"
+#include "plslam/inertial/imu_ba_factor.h"
 
 namespace plslam::mapping {
 
@@ -60,6 +63,49 @@ void MapBaProblem::add_landmarks_of(const std::vector<map::KeyFrame*>& kfs) {
       problem.line_observations.push_back(o);
       line_observers.push_back(k);
     }
+  }
+}
+
+void MapBaProblem::fill_keyframe_extra() {
+  for (std::size_t k = problem.keyframe_extra.size(); k < keyframes.size(); ++k) {
+    const auto imu = keyframes[k]->imu();
+    problem.keyframe_extra.push_back(imu ? inertial::ba_extra_state(imu->v, imu->bias) : optim::Vector9d::Zero());
+  }
+}
+
+void MapBaProblem::add_imu_factors(const std::vector<map::KeyFrame*>& chain, const geometry::SE3& T_imu_cam,
+                                   const inertial::ReintegrationThresholds& reintegration, bool add_missing) {
+  fill_keyframe_extra();
+  for (map::KeyFrame* j : chain) {
+    const auto imu = j->imu();
+    const auto j_it = index_.find(j);
+    if (!imu || !imu->previous || !imu->from_previous || j_it == index_.end()) continue;
+    const auto i_it = index_.find(imu->previous);
+    if (i_it == index_.end() && !add_missing) continue;
+    const int i_index = i_it != index_.end() ? i_it->second : add_keyframe(imu->previous, true);
+    fill_keyframe_extra();
+    const inertial::ImuBias bias_i = inertial::bias_of(problem.keyframe_extra[static_cast<std::size_t>(i_index)]);
+    const inertial::Preintegration* pim = imu->from_previous.get();
+    std::optional<inertial::Preintegration> again;
+    if (pim->bias_moved_far(bias_i, reintegration)) {
+      again.emplace(*pim);
+      again->reintegrate(bias_i);
+      pim = &*again;
+    }
+    problem.keyframe_factors.push_back(std::make_shared<inertial::ImuBaFactor>(i_index, j_it->second, *pim, T_imu_cam));
+  }
+}
+
+void MapBaProblem::write_back_imu_states(const optim::BaResult& result) const {
+  if (result.keyframe_extra.empty()) return;
+  std::vector<bool> in_factor(keyframes.size(), false);
+  for (const auto& f : problem.keyframe_factors) {
+    for (const int k : f->keyframes()) in_factor[static_cast<std::size_t>(k)] = true;
+  }
+  for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    if (!in_factor[k] || problem.keyframes[k].fixed || keyframes[k]->is_bad() || !keyframes[k]->has_imu()) continue;
+    keyframes[k]->set_imu_velocity_and_bias(inertial::velocity_of(result.keyframe_extra[k]),
+                                            inertial::bias_of(result.keyframe_extra[k]));
   }
 }
 

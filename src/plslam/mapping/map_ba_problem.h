@@ -4,6 +4,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "plslam/geometry/se3.h"
+#include "plslam/inertial/preintegration.h"
 #include "plslam/map/keyframe.h"
 #include "plslam/map/map_line.h"
 #include "plslam/map/map_point.h"
@@ -21,6 +23,16 @@ class MapBaProblem {
   // The points (and lines) these keyframes see, each once, with every observation by a good
   // keyframe; observers not added yet join as fixed keyframes.
   void add_landmarks_of(const std::vector<map::KeyFrame*>& keyframes);
+  // An IMU factor (inertial/imu_ba_factor.h) between each keyframe of `chain` with an IMU state and
+  // its predecessor in the IMU chain, and every keyframe's extra state ([v; bg; ba], zero without
+  // a state). A predecessor not in the problem joins fixed when `add_missing`, else that factor is
+  // left out. A preintegration whose first keyframe's bias moved past `reintegration` is
+  // integrated again at it. Call after every keyframe is added.
+  void add_imu_factors(const std::vector<map::KeyFrame*>& chain, const geometry::SE3& T_imu_cam,
+                       const inertial::ReintegrationThresholds& reintegration, bool add_missing);
+  // Writes a result's velocities and biases into the free keyframes that have IMU factors (their
+  // states become `estimated`).
+  void write_back_imu_states(const optim::BaResult& result) const;
 
   optim::BaProblem problem;
   std::vector<map::KeyFrame*> keyframes;  // indexed like problem.keyframes
@@ -35,6 +47,7 @@ class MapBaProblem {
   double far_stereo_baselines_;
   bool with_lines_;
   std::unordered_map<const map::KeyFrame*, int> index_;
+  void fill_keyframe_extra();
 };
 
 }  // namespace plslam::mapping

@@ -77,6 +77,48 @@ class LineEndpointsManifold : public ceres::Manifold {
   Eigen::Matrix<double, 3, 2> B_;
 };
 
+// A keyframe factor (ba_keyframe_factor.h) as a Ceres cost: per keyframe its pose block (7, the
+// Jacobian over the left delta in the first 6 columns, as SE3LeftManifold expects) and its
+// extra-state block (9).
+class KeyframeFactorCost final : public ceres::CostFunction {
+ public:
+  explicit KeyframeFactorCost(const BaKeyframeFactor& factor) : factor_(factor) {
+    set_num_residuals(factor.rows());
+    for (std::size_t k = 0; k < factor.keyframes().size(); ++k) {
+      mutable_parameter_block_sizes()->push_back(7);
+      mutable_parameter_block_sizes()->push_back(9);
+    }
+  }
+  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
+    const std::size_t n = factor_.keyframes().size();
+    std::vector<geometry::SE3> T;
+    std::vector<Vector9d> x;
+    for (std::size_t k = 0; k < n; ++k) {
+      T.push_back(from_params(params[2 * k]));
+      x.emplace_back(Eigen::Map<const Vector9d>(params[2 * k + 1]));
+    }
+    Eigen::MatrixXd J;
+    const Eigen::VectorXd r = factor_.evaluate(T, x, jacobians ? &J : nullptr);
+    const int rows = factor_.rows();
+    Eigen::Map<Eigen::VectorXd>(residuals, rows) = r;
+    if (!jacobians) return r.allFinite();
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto c = static_cast<Eigen::Index>(BaKeyframeFactor::kColumnsPerKeyframe * k);
+      if (jacobians[2 * k]) {
+        Eigen::Map<RowMajor> Jp(jacobians[2 * k], rows, 7);
+        Jp.setZero();
+        Jp.leftCols(6) = J.middleCols(c, 6);
+      }
+      if (jacobians[2 * k + 1]) Eigen::Map<RowMajor>(jacobians[2 * k + 1], rows, 9) = J.middleCols(c + 6, 9);
+    }
+    return r.allFinite() && J.allFinite();
+  }
+
+ private:
+  const BaKeyframeFactor& factor_;
+};
+
 }  // namespace
 
 BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& p,
@@ -152,6 +194,25 @@ BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& 
       problem.AddResidualBlock(new StereoLinePairCost(cam, o, right, sqrt_info), loss, pose,
                                s->lines[li].data());
     }
+  }
+
+  // Keyframe factors: the extra states join the poses' elimination group.
+  std::vector<bool> extra_added(p.keyframes.size(), false);
+  for (const auto& f : p.keyframe_factors) {
+    std::vector<double*> blocks;
+    for (const int kf : f->keyframes()) {
+      blocks.push_back(add_pose(kf));
+      const auto k = static_cast<std::size_t>(kf);
+      double* x = s->extra[k].data();
+      if (!extra_added[k]) {
+        extra_added[k] = true;
+        problem.AddParameterBlock(x, 9);
+        if (p.keyframes[k].fixed) problem.SetParameterBlockConstant(x);
+        ordering->AddElementToGroup(x, 1);
+      }
+      blocks.push_back(x);
+    }
+    problem.AddResidualBlock(new KeyframeFactorCost(*f), nullptr, blocks);
   }
 
   ceres::Solver::Options so;

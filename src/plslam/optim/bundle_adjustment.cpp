@@ -77,19 +77,43 @@ BaExclusions gate(const geometry::StereoCamera& cam, const BaProblem& p, const B
   return g;
 }
 
+// spec's exclusions plus the observations whose landmark is behind its camera at s: Ceres refuses
+// to start from them, the Schur backend leaves them out of the pass; the final gate flags them.
+BaExclusions with_behind_camera(const BaProblem& p, const BaPassSpec& spec,
+                                const BaState& s) {
+  BaExclusions ex;
+  if (spec.excluded) ex = *spec.excluded;
+  ex.point_out.resize(p.point_observations.size(), false);
+  ex.line_out.resize(p.line_observations.size(), false);
+  for (std::size_t k = 0; k < p.point_observations.size(); ++k) {
+    const auto& o = p.point_observations[k];
+    const Eigen::Vector3d Xc = s.poses[static_cast<std::size_t>(o.keyframe)] * s.points[static_cast<std::size_t>(o.point)];
+    if (!(Xc.z() > 0.0)) ex.point_out[k] = true;
+  }
+  for (std::size_t k = 0; k < p.line_observations.size(); ++k) {
+    const auto& o = p.line_observations[k];
+    const auto& T = s.poses[static_cast<std::size_t>(o.keyframe)];
+    const auto& L = s.lines[static_cast<std::size_t>(o.line)];
+    if (!((T * Eigen::Vector3d(L.head<3>())).z() > 0.0) || !((T * Eigen::Vector3d(L.tail<3>())).z() > 0.0)) ex.line_out[k] = true;
+  }
+  return ex;
+}
+
 BaPassSummary run_pass(const geometry::StereoCamera& cam, const BaProblem& p,
                        const BaOptions& opt, const BaPassSpec& spec, BaState* s) {
   if (opt.backend == BaBackend::kSchurLM) {
     int free_keyframes = 0;
     for (const auto& kf : p.keyframes) free_keyframes += kf.fixed ? 0 : 1;
-    if (free_keyframes <= opt.max_dense_keyframes || !p.keyframe_factors.empty()) {
-      return schur_lm_ba_pass(cam, p, opt, spec, s);
-    }
+    // Keyframe factors add 9 dense unknowns per keyframe: the limit is on the system's size.
+    const int per_keyframe = p.keyframe_factors.empty() ? 6 : 15;
+    if (per_keyframe * free_keyframes <= 6 * opt.max_dense_keyframes) return schur_lm_ba_pass(cam, p, opt, spec, s);
     BaOptions sparse = opt;
     sparse.linear_solver = BaLinearSolver::kSparseSchur;
-    return ceres_ba_pass(cam, p, sparse, spec, s);
+    const BaExclusions ex = with_behind_camera(p, spec, *s);
+    BaPassSpec valid = spec;
+    valid.excluded = &ex;
+    return ceres_ba_pass(cam, p, sparse, valid, s);
   }
-  if (!p.keyframe_factors.empty()) throw std::invalid_argument("bundle_adjust: the Ceres backend takes no keyframe factors");
   return ceres_ba_pass(cam, p, opt, spec, s);
 }
 

@@ -48,8 +48,8 @@ struct BaProblem {
   std::vector<StereoLineObservation> line_observations;
   // Factors between keyframes (ba_keyframe_factor.h: the IMU's, in a visual-inertial BA) and, with
   // them, one extra state per keyframe, which moves with its keyframe's pose and is held with it.
-  // The Schur backend only: a problem with factors stays there whatever its size, and the Ceres
-  // backend refuses it (std::invalid_argument).
+  // Both backends take them; kSchurLM hands a problem to Ceres' SPARSE_SCHUR once its dense system
+  // (15 per free keyframe with factors) passes 6 max_dense_keyframes.
   std::vector<Vector9d> keyframe_extra;
   std::vector<std::shared_ptr<const BaKeyframeFactor>> keyframe_factors;
 };

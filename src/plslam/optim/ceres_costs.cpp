@@ -1,6 +1,11 @@
 #include "plslam/optim/ceres_costs.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
 
 #include "plslam/optim/stereo_line_residual.h"
 #include "plslam/optim/stereo_point_residual.h"
@@ -34,6 +39,56 @@ bool SE3LeftManifold::MinusJacobian(const double*, double* jacobian) const {
   Eigen::Map<Eigen::Matrix<double, 6, 7, Eigen::RowMajor>> J(jacobian);
   J.setZero();
   J.leftCols<6>().setIdentity();
+  return true;
+}
+
+namespace {
+
+// d(left delta of T_cw) / d[dc; a] at x (YawTranslationManifold).
+Eigen::Matrix<double, 6, 4> yaw_translation_basis(const SE3& T_cw) {
+  const Eigen::Vector3d c = T_cw.inverse().translation(), z = Eigen::Vector3d::UnitZ();
+  Eigen::Matrix<double, 6, 4> G = Eigen::Matrix<double, 6, 4>::Zero();
+  G.topLeftCorner<3, 3>().setIdentity();
+  G.block<3, 1>(0, 3) = -z.cross(c);
+  G.block<3, 1>(3, 3) = z;
+  return -T_cw.adjoint() * G;
+}
+
+}  // namespace
+
+bool YawTranslationManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
+  const SE3 T_wc = from_params(x).inverse();
+  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(delta[3], Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const SE3 moved(Rz * T_wc.rotation(), T_wc.translation() + Eigen::Vector3d(delta[0], delta[1], delta[2]));
+  const PoseParams out = to_params(moved.inverse().normalized());
+  std::copy(out.begin(), out.end(), x_plus_delta);
+  return true;
+}
+
+bool YawTranslationManifold::PlusJacobian(const double* x, double* jacobian) const {
+  Eigen::Map<Eigen::Matrix<double, 7, 4, Eigen::RowMajor>> J(jacobian);
+  J.setZero();
+  J.topRows<6>() = yaw_translation_basis(from_params(x));
+  return true;
+}
+
+bool YawTranslationManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
+  const SE3 Ty = from_params(y).inverse(), Tx = from_params(x).inverse();
+  const Eigen::Matrix3d dR = Ty.rotation() * Tx.rotation().transpose();
+  const Eigen::Vector3d dc = Ty.translation() - Tx.translation();
+  y_minus_x[0] = dc.x();
+  y_minus_x[1] = dc.y();
+  y_minus_x[2] = dc.z();
+  y_minus_x[3] = std::atan2(dR(1, 0), dR(0, 0));
+  return true;
+}
+
+bool YawTranslationManifold::MinusJacobian(const double* x, double* jacobian) const {
+  // The left inverse of PlusJacobian's 6 x 4 block, so that Minus o Plus is the identity to first order.
+  const Eigen::Matrix<double, 6, 4> B = yaw_translation_basis(from_params(x));
+  Eigen::Map<Eigen::Matrix<double, 4, 7, Eigen::RowMajor>> J(jacobian);
+  J.setZero();
+  J.leftCols<6>() = (B.transpose() * B).inverse() * B.transpose();
   return true;
 }
 

@@ -29,6 +29,22 @@ class SE3LeftManifold final : public ceres::Manifold {
   bool MinusJacobian(const double* x, double* jacobian) const override;
 };
 
+// The same pose block moved only by a yaw about the world's z axis and a world translation, the
+// 4 directions a visual-inertial map leaves open (roll and pitch are observable from gravity):
+// T_wc <- [Rz(a) R_wc, c + dc], tangent [dc (3, world); a]. PlusJacobian is the left delta of T_cw
+// per tangent direction in the first 6 ambient rows, as SE3LeftManifold's convention wants the
+// costs' Jacobians: [-Ad(T_cw) [I, -e_z x c; 0, e_z]; 0].
+class YawTranslationManifold final : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return 7; }
+  int TangentSize() const override { return 4; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  // [c_y - c_x; the yaw of R_wc_y R_wc_x'], the inverse of Plus where y differs from x by such a move.
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+};
+
 // Whitened stereo point residual sqrt(info) * (project_stereo(T X) - z); blocks: pose, point.
 class StereoPointCost final : public ceres::SizedCostFunction<3, 7, 3> {
  public:

@@ -22,12 +22,14 @@ PoseGraphResult optimize_pose_graph(const std::vector<geometry::SE3>& poses,
   x.reserve(poses.size());
   for (const auto& T : poses) x.push_back(to_params(T));
 
-  SE3LeftManifold manifold;
+  SE3LeftManifold se3;
+  YawTranslationManifold yaw_translation;
+  ceres::Manifold* manifold = options.four_dof ? static_cast<ceres::Manifold*>(&yaw_translation) : &se3;
   ceres::Problem::Options po;
   po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(po);
   for (std::size_t k = 0; k < x.size(); ++k) {
-    problem.AddParameterBlock(x[k].data(), 7, &manifold);
+    problem.AddParameterBlock(x[k].data(), 7, manifold);
     if (fixed[k]) problem.SetParameterBlockConstant(x[k].data());
   }
   const auto n = static_cast<int>(poses.size());

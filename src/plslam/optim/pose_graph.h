@@ -1,6 +1,7 @@
 #pragma once
 // SE(3) pose-graph optimisation (stereo: scale is observable, so no Sim(3)) for the essential
-// graph after a loop closure, on Ceres with analytic Jacobians of the relative-pose error.
+// graph after a loop closure, on Ceres with analytic Jacobians of the relative-pose error; or
+// 4-DoF (PoseGraphOptions::four_dof) in a gravity-aligned visual-inertial map.
 #include <vector>
 
 #include "plslam/geometry/se3.h"
@@ -18,6 +19,9 @@ struct PoseGraphEdge {
 
 struct PoseGraphOptions {
   int iterations = 20;
+  // Move each free node only by a yaw about the world's z axis and a translation (a visual-inertial
+  // map, whose z axis is up: roll and pitch are observable from gravity and stay as they are).
+  bool four_dof = false;
   int num_threads = 1;
 };
 

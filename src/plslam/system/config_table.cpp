@@ -367,6 +367,8 @@ std::vector<ConfigKey> make_table() {
           "deterministic mode: a loop correction's essential graph is solved beside tracking and the rest of "
           "the map moves before the frame this many frames after the correction began", at_least(1)),
 
+    field("imu", "enabled", [](auto& o) -> auto& { return o.use_input_imu; },
+          "plslam run uses the input's IMU (false: stereo only, as --no-imu)"),
     field("imu", "visual_inertial", [](auto& o) -> auto& { return o.visual_inertial; },
           "once the IMU is initialised, tracking and local BA use it (false: it only turns the world to gravity)"),
     field("imu", "local_ba_keyframes", [](auto& o) -> auto& { return o.mapper.imu_window; },

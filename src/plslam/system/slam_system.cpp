@@ -232,7 +232,9 @@ void System::align_world_with_gravity(long frame_id) {
     // The IMU's residuals assume gravity along -z: from here on tracking and local BA use them.
     if (options_.visual_inertial) {
       tracker_->use_imu(*imu_data_, imu_init_->result()->bias);
-      mapper_->use_imu(geometry::SE3(imu_data_->T_imu_cam));
+      const geometry::SE3 T_imu_cam(imu_data_->T_imu_cam);
+      mapper_->use_imu(T_imu_cam);
+      if (loop_closer_) loop_closer_->use_imu(T_imu_cam);
     }
     if (loop_closer_) loop_closer_->resume();
   }

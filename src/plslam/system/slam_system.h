@@ -56,6 +56,9 @@ struct SystemOptions {
   // local BA keeps the IMU's factors (stereo-inertial). false: the IMU only turns the world to
   // gravity (stereo).
   bool visual_inertial = true;
+  // Config imu.enabled: false leaves an input's IMU unused in `plslam run`, as --no-imu does
+  // (stereo only, the world the first camera's; bench slam's `stereo` configuration).
+  bool use_input_imu = true;
 
   static SystemOptions euroc();
   static SystemOptions kitti();
