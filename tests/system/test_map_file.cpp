@@ -3,6 +3,7 @@
 // sequence mapped once per suite.
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <memory>
@@ -386,6 +387,9 @@ TEST_F(MapReuse, InfoAndExport) {
   EXPECT_EQ(j["keyframes"], contents.keyframes.size());
   EXPECT_EQ(j["points"], contents.points.size());
   EXPECT_EQ(j["lines"], contents.lines.size());
+  EXPECT_EQ(j["version"], system::kMapFileVersion);
+  // A run's map has IMU states exactly when the run turned its world to gravity.
+  EXPECT_EQ(j["gravity_aligned"].get<bool>(), j["keyframes_with_imu_state"].get<long>() > 0) << r.out;
   EXPECT_EQ(j["calibration"]["width"], 752);
   EXPECT_FALSE(j["vocabulary"].is_null());
   EXPECT_EQ(j["ground_truth_anchor"], true);
@@ -436,12 +440,51 @@ TEST(MapFileFormat, HandMadeContentsRoundTripExactly) {
   EXPECT_EQ(r.points[0].observations, c.points[0].observations);
   EXPECT_EQ(r.points[0].state.visible, 4);
   EXPECT_EQ(r.lines[0].b, c.lines[0].b);
+  EXPECT_TRUE(r.meta.gravity_aligned);
+  ASSERT_TRUE(r.keyframes[0].imu && r.keyframes[1].imu);
+  EXPECT_EQ(r.keyframes[0].imu->previous, -1);
+  EXPECT_TRUE(r.keyframes[0].imu->estimated);
+  const auto& imu = *r.keyframes[1].imu;
+  EXPECT_EQ(imu.v, c.keyframes[1].imu->v);
+  EXPECT_EQ(imu.bias.acc, c.keyframes[1].imu->bias.acc);
+  EXPECT_FALSE(imu.estimated);
+  EXPECT_EQ(imu.previous, 0);
+  ASSERT_NE(imu.from_previous, nullptr);
+  // Integrated again from the saved samples: the same deltas, bit for bit.
+  const auto& pim = *c.keyframes[1].imu->from_previous;
+  EXPECT_TRUE(imu.from_previous->delta_R() == pim.delta_R());
+  EXPECT_TRUE(imu.from_previous->delta_p() == pim.delta_p());
+  EXPECT_TRUE(imu.from_previous->covariance() == pim.covariance());
   map::Map map;
   system::restore_map(r, map, nullptr);
+  ASSERT_TRUE(map.keyframes()[1]->has_imu());
+  EXPECT_EQ(map.keyframes()[1]->imu()->previous, map.keyframes()[0]);
+  EXPECT_EQ(map.keyframes()[0]->imu_next(), map.keyframes()[1]);
+  EXPECT_EQ(map.keyframes()[1]->imu()->from_previous, imu.from_previous);
   EXPECT_EQ(map.keyframes()[1]->parent(), map.keyframes()[0]);
   EXPECT_EQ(map.keyframes()[0]->loop_edges().size(), 1u);
   EXPECT_EQ(map.points()[0]->observation_weight(), 4);  // two stereo observations
   EXPECT_EQ(map.next_ids().point, 5);
+}
+
+// Files of format version 1 (before the IMU states) are read: no IMU state, a world not known to be
+// gravity-aligned. The fuzz seed tiny_two_keyframes is one.
+TEST(MapFileFormat, VersionOneFilesAreRead) {
+  const auto path = fs::path(PLSLAM_SOURCE_DIR) / "tests" / "fuzz" / "corpus" / "map_file" / "tiny_two_keyframes";
+  const std::string bytes = test::read_file(path);
+  std::uint32_t version = 0;
+  ASSERT_GE(bytes.size(), 12u);
+  std::memcpy(&version, bytes.data() + 8, 4);
+  ASSERT_EQ(version, 1u);
+  const auto r = system::map_from_bytes(bytes, path.string());
+  ASSERT_EQ(r.keyframes.size(), 2u);
+  EXPECT_EQ(r.meta.version, 1u);
+  EXPECT_FALSE(r.meta.gravity_aligned);
+  EXPECT_FALSE(r.keyframes[0].imu || r.keyframes[1].imu);
+  // Written again, it is a version 2 file with the same contents.
+  const auto again = system::map_from_bytes(system::map_to_bytes(r), "again.plmap");
+  EXPECT_EQ(again.keyframes.size(), 2u);
+  EXPECT_EQ(again.points[0].observations, r.points[0].observations);
 }
 
 // What the structure checks catch behind valid checksums.
@@ -464,6 +507,13 @@ TEST(MapFileFormat, InconsistentContentsAreRejected) {
          p->bow[1].first = 10;
          c.keyframes[0].place = p;
        }, "bad word"},
+      {[](auto& c) { c.keyframes[1].imu->previous = 7; }, "IMU predecessor 7 unknown"},
+      {[](auto& c) { c.keyframes[0].imu.reset(); }, "IMU predecessor 0 has no IMU state"},
+      {[](auto& c) {
+         auto d = std::make_shared<map::FrameData>(*c.keyframes[1].data);
+         d->timestamp = 0.6;  // the samples end at 0.5
+         c.keyframes[1].data = d;
+       }, "is not the one from keyframe 0"},
   };
   for (const auto& [edit, expected] : cases) {
     auto c = test::tiny_map_contents();

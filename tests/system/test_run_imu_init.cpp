@@ -1,7 +1,8 @@
 // The visual-inertial initialisation during `plslam run`: on the real EuRoC micro excerpt (the
 // drone stands nearly still) gravity is refused as unobservable and the gyro bias is estimated,
 // against EuRoC's ground-truth bias; a rendered handheld walk with EuRoC's noise and biases is
-// initialised with gravity and the gyro bias near the truth.
+// initialised with gravity and the gyro bias near the truth, and its map file, with the IMU
+// states, is loaded with the IMU (stereo-inertial in the map's world) and without.
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "plslam/io/text_table.h"
+#include "plslam/system/map_file.h"
 #include "support/test_support.h"
 
 namespace plslam {
@@ -19,8 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-nlohmann::json run_imu(const fs::path& seq, const fs::path& out) {
-  const auto r = test::run_cli("run \"" + seq.string() + "\" --out \"" + out.string() + "\" --quiet");
+nlohmann::json run_imu(const fs::path& seq, const fs::path& out, const std::string& extra = "") {
+  const auto r = test::run_cli("run \"" + seq.string() + "\" --out \"" + out.string() + "\" --quiet" + extra);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(out / "stats.json");
   if (r.exit_code != 0 || !in) return {};
@@ -67,7 +69,8 @@ TEST(RunImuInit, RenderedHandheldWalkIsInitialisedNearTheTruth) {
   const auto synth = test::run_cli("synth --out \"" + seq.string() +
                                    "\" --scene office --frames 170 --seed 4 --motion handheld --imu-noise euroc");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
-  const auto imu = run_imu(seq, tmp.path() / "run");
+  const fs::path map_file = tmp.path() / "walk.plmap";
+  const auto imu = run_imu(seq, tmp.path() / "run", " --save-map \"" + map_file.string() + "\"");
   ASSERT_TRUE(imu.is_object());
   ASSERT_TRUE(imu["initialised"].get<bool>()) << imu.dump();
   const auto& init = imu["initialisation"];
@@ -128,6 +131,39 @@ TEST(RunImuInit, RenderedHandheldWalkIsInitialisedNearTheTruth) {
   const Eigen::Vector3d bg_end(last[11], last[12], last[13]), ba_end(last[14], last[15], last[16]);
   EXPECT_LT((vec(slam["final_gyro_bias"]) - bg_end).norm(), 0.05 * bg_end.norm());
   EXPECT_LT((vec(slam["final_acc_bias"]) - ba_end).norm(), 0.03);
+
+  // The map file carries the world's alignment and the keyframes' IMU states, chained in time.
+  const auto saved = system::load_map_file(map_file);
+  EXPECT_TRUE(saved.meta.gravity_aligned);
+  std::size_t with_imu = 0, chained = 0;
+  for (const auto& k : saved.keyframes) {
+    with_imu += k.imu.has_value();
+    chained += k.imu && k.imu->previous >= 0;
+  }
+  std::printf("map file: %zu keyframes, %zu with an IMU state, %zu chained\n", saved.keyframes.size(), with_imu, chained);
+  EXPECT_GE(with_imu, 10u);
+  EXPECT_GE(chained + 1, with_imu);
+  // It loads in both modes. With the IMU, the run relocalizes in it, initialises again, finds
+  // gravity where the map has its z axis and tracks stereo-inertial in the map's world as it is.
+  const auto again = run_imu(seq, tmp.path() / "again", " --load-map \"" + map_file.string() + "\"");
+  ASSERT_TRUE(again.is_object());
+  std::printf("loaded with the IMU: %s\n", again["world"].dump().c_str());
+  EXPECT_EQ(again["world"]["loaded_map_gravity_aligned"], true) << again.dump();
+  EXPECT_LT(again["world"]["loaded_map_tilt_deg"].get<double>(), 1.0) << again.dump();
+  EXPECT_EQ(again["slam"]["mode"], "stereo-inertial") << again["slam"].dump();
+  EXPECT_GE(again["slam"]["imu_tracked_frames"].get<int>(), 30) << again["slam"].dump();
+  // The first frames relocalize: 4 frames 'recovering' until the place is confirmed (measured).
+  const auto stats = nlohmann::json::parse(test::read_file(tmp.path() / "again" / "stats.json"));
+  EXPECT_GE(stats["tracked_frames"].get<int>(), 160);
+  EXPECT_EQ(stats["frame_states"]["lost"], 0);
+  EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.03) << stats["accuracy"].dump();
+  // Without it (localization only: stereo), every frame is localized in the map as well.
+  const auto r = test::run_cli("run \"" + seq.string() + "\" --out \"" + (tmp.path() / "localize").string() +
+                               "\" --quiet --localize --load-map \"" + map_file.string() + "\"");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  const auto localized = nlohmann::json::parse(test::read_file(tmp.path() / "localize" / "stats.json"));
+  EXPECT_GE(localized["tracked_frames"].get<int>(), 160);
+  EXPECT_EQ(localized["frame_states"]["lost"], 0);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 #pragma once
 // A hand-made map file content with every kind of record (two keyframes with keypoints, lines and
-// bags of words, a point and a line seen by both, a covisibility edge, a parent, a loop edge): the
-// exact-data test of the format, and the fuzz seed of tests/fuzz/corpus/map_file.
+// bags of words, a point and a line seen by both, a covisibility edge, a parent, a loop edge, IMU
+// states chained by 0.5 s of IMU samples): the exact-data test of the format, and the fuzz seed
+// tests/fuzz/corpus/map_file/tiny_with_imu (tiny_two_keyframes is the version 1 file, without IMU).
 #include <memory>
 
 #include "plslam/system/map_file.h"
@@ -58,8 +59,21 @@ inline system::MapContents tiny_map_contents() {
     k.parent = id == 1 ? 0 : -1;
     k.covisibility = {{1 - id, 2}};
     k.loop_edges = {1 - id};
+    system::SavedImuState imu;
+    imu.v = Eigen::Vector3d(0.2, -0.1, 0.05 * static_cast<double>(id));
+    imu.bias.gyro = Eigen::Vector3d(1e-3, -2e-3, 3e-3);
+    imu.bias.acc = Eigen::Vector3d(0.02, 0.01, -0.03);
+    imu.estimated = id == 0;
+    if (id == 1) {
+      std::vector<ImuSample> samples;
+      for (int i = 0; i <= 5; ++i) samples.push_back({0.1 * i, Eigen::Vector3d(0.1, 0.02 * i, -0.05), Eigen::Vector3d(0.3, -0.2 * i, 9.81)});
+      imu.previous = 0;
+      imu.from_previous = std::make_shared<const inertial::Preintegration>(samples, 0.0, 0.5, imu.bias, kEurocAdis16448Noise);
+    }
+    k.imu = imu;
     c.keyframes.push_back(k);
   }
+  m.gravity_aligned = true;
   system::SavedLandmark p;
   p.id = 3;
   p.created_frame = 0;

@@ -38,9 +38,11 @@ std::string read_whole_file(const fs::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-// --check: the file restores into a map (and keyframe database) that saves to the file's own bytes.
+// --check: the file restores into a map (and keyframe database) that saves to the file's own bytes
+// (a file of an older format version: to its contents written in the current one).
 nlohmann::json check_round_trip(const system::MapContents& contents, const MapInfoArgs& args) {
-  const std::string original = read_whole_file(args.file);
+  const std::string original = contents.meta.version == system::kMapFileVersion ? read_whole_file(args.file)
+                                                                                 : system::map_to_bytes(contents);
   system::SystemOptions options;
   if (!args.vocabulary.empty()) options.vocabulary = args.vocabulary;
   const auto vocabulary = system::load_vocabulary(options);
@@ -129,6 +131,8 @@ nlohmann::json map_info_json(const system::MapContents& c, const fs::path& file,
       {"extent_m", box(lo, hi)},
       {"keyframe_extent_m", box(klo, khi)},
       {"ground_truth_anchor", m.T_gt_map.has_value()},
+      {"gravity_aligned", m.gravity_aligned},
+      {"keyframes_with_imu_state", std::count_if(c.keyframes.begin(), c.keyframes.end(), [](const auto& k) { return k.imu.has_value(); })},
       {"config", m.config}};
   return j;
 }
@@ -156,6 +160,9 @@ int run_map_info(const MapInfoArgs& args) {
   std::cout << fmt::format("keyframes {}, points {}, lines {}, covisibility edges {}, loop edges {}\n",
                            contents.keyframes.size(), contents.points.size(), contents.lines.size(),
                            j["covisibility_edges"].get<std::size_t>(), j["loop_edges"].get<std::size_t>());
+  std::cout << fmt::format("world: {}, {} keyframes with an IMU state\n",
+                           contents.meta.gravity_aligned ? "gravity-aligned (z up)" : "the first keyframe's",
+                           j["keyframes_with_imu_state"].get<long>());
   if (!j["extent_m"].is_null()) {
     const auto& e = j["extent_m"];
     std::cout << fmt::format("extent: x {:.2f} .. {:.2f}, y {:.2f} .. {:.2f}, z {:.2f} .. {:.2f} m\n",

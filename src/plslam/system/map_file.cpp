@@ -27,7 +27,11 @@ namespace plslam::system {
 namespace {
 
 constexpr char kMagic[8] = {'p', 'l', 's', 'l', 'm', 'a', 'p', '\0'};
-constexpr char kSectionTags[5][5] = {"META", "KFRM", "MPTS", "MLIN", "GRPH"};
+constexpr char kSectionTags[6][5] = {"META", "KFRM", "MPTS", "MLIN", "GRPH", "IMUS"};
+constexpr std::uint32_t kVersion1Sections = 5;
+constexpr std::size_t kImuSampleBytes = 7 * 8;
+// Timestamps are written as read; an interval's ends are its keyframes' times to this (seconds).
+constexpr double kImuTimeTolerance = 1e-6;
 constexpr std::size_t kKeypointBytes = 5 * 4 + 2 * 4;
 constexpr std::size_t kLineBytes = 5 * 4 + 4 + 12 * 8 + 1;
 constexpr int kMaxLevels = 32;
@@ -181,6 +185,27 @@ void write_graph(Writer& w, const SavedKeyframe& k) {
   }
   w.put_count(k.loop_edges.size());
   for (long id : k.loop_edges) w.put<std::int64_t>(id);
+}
+
+void write_imu_state(Writer& w, long id, const SavedImuState& s) {
+  w.put<std::int64_t>(id);
+  w.put_vec3(s.v);
+  w.put_vec3(s.bias.gyro);
+  w.put_vec3(s.bias.acc);
+  w.put<std::uint8_t>(s.estimated);
+  w.put<std::int64_t>(s.from_previous ? s.previous : -1);
+  if (!s.from_previous) return;
+  const auto& pim = *s.from_previous;
+  w.put_vec3(pim.linearisation_bias().gyro);
+  w.put_vec3(pim.linearisation_bias().acc);
+  const auto& n = pim.noise();
+  for (double v : {n.gyro_noise_density, n.gyro_random_walk, n.acc_noise_density, n.acc_random_walk}) w.put<double>(v);
+  w.put_count(pim.samples().size());
+  for (const auto& smp : pim.samples()) {
+    w.put<double>(smp.t);
+    w.put_vec3(smp.gyro);
+    w.put_vec3(smp.acc);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -449,6 +474,48 @@ void read_graph(Reader& r, SavedKeyframe& k) {
   }
 }
 
+// One IMU state; its keyframe and predecessor are checked in check_references. The preintegration
+// is integrated again from the samples (what Preintegration refuses is an InputError here).
+std::pair<long, SavedImuState> read_imu_state(Reader& r) {
+  const long id = r.get_id("IMU state keyframe");
+  SavedImuState s;
+  s.v = r.get_vec3();
+  s.bias.gyro = r.get_vec3();
+  s.bias.acc = r.get_vec3();
+  const auto estimated = r.get<std::uint8_t>();
+  if (estimated > 1) r.fail(fmt::format("keyframe {}: bad IMU state flag", id));
+  s.estimated = estimated == 1;
+  const auto previous = r.get<std::int64_t>();
+  if (previous < -1 || previous >= kMaxId) r.fail(fmt::format("keyframe {}: IMU predecessor {} out of range", id, previous));
+  s.previous = static_cast<long>(previous);
+  if (s.previous < 0) return {id, s};
+  inertial::ImuBias lin;
+  lin.gyro = r.get_vec3();
+  lin.acc = r.get_vec3();
+  ImuNoise noise;
+  for (double* v : {&noise.gyro_noise_density, &noise.gyro_random_walk, &noise.acc_noise_density, &noise.acc_random_walk}) {
+    *v = r.get_finite();
+    if (*v < 0) r.fail(fmt::format("keyframe {}: negative IMU noise", id));
+  }
+  const std::size_t n = r.count(kImuSampleBytes);
+  if (n < 2) r.fail(fmt::format("keyframe {}: {} IMU samples (at least 2)", id, n));
+  std::vector<ImuSample> samples(n);
+  for (auto& smp : samples) {
+    smp.t = r.get_finite();
+    smp.gyro = r.get_vec3();
+    smp.acc = r.get_vec3();
+  }
+  for (std::size_t i = 1; i < n; ++i) {
+    if (!(samples[i].t > samples[i - 1].t)) r.fail(fmt::format("keyframe {}: IMU sample times not increasing", id));
+  }
+  try {
+    s.from_previous = std::make_shared<const inertial::Preintegration>(samples, samples.front().t, samples.back().t, lin, noise);
+  } catch (const std::invalid_argument& e) {
+    r.fail(fmt::format("keyframe {}: {}", id, e.what()));
+  }
+  return {id, s};
+}
+
 // Cross-references: every id a record names exists, every feature index lies in its keyframe and
 // holds one landmark at most, and the spanning tree has no cycle.
 void check_references(const MapContents& c, const std::string& source) {
@@ -491,11 +558,31 @@ void check_references(const MapContents& c, const std::string& source) {
     for (long id : k.loop_edges) {
       if (!index.count(id)) fail(fmt::format("keyframe {}: loop edge to unknown keyframe {}", k.id, id));
     }
+    if (k.imu && k.imu->previous >= 0) {
+      // The chain runs forward in time, one successor per keyframe (checked below), over the
+      // interval between the two keyframes.
+      const auto prev = index.find(k.imu->previous);
+      if (prev == index.end()) fail(fmt::format("keyframe {}: IMU predecessor {} unknown", k.id, k.imu->previous));
+      const auto& before = c.keyframes[prev->second];
+      if (!before.imu) fail(fmt::format("keyframe {}: IMU predecessor {} has no IMU state", k.id, before.id));
+      const auto& pim = *k.imu->from_previous;
+      if (std::abs(pim.t_i() - before.data->timestamp) > kImuTimeTolerance ||
+          std::abs(pim.t_j() - k.data->timestamp) > kImuTimeTolerance || !(before.data->timestamp < k.data->timestamp)) {
+        fail(fmt::format("keyframe {}: IMU interval [{:.6f}, {:.6f}] is not the one from keyframe {} ({:.6f}) to it ({:.6f})",
+                         k.id, pim.t_i(), pim.t_j(), before.id, before.data->timestamp, k.data->timestamp));
+      }
+    }
     // Walking up must reach a root within as many steps as there are keyframes.
     long at = k.parent;
     for (std::size_t steps = 0; at >= 0; ++steps) {
       if (steps > c.keyframes.size() || at == k.id) fail(fmt::format("keyframe {}: the spanning tree has a cycle", k.id));
       at = c.keyframes[index.at(at)].parent;
+    }
+  }
+  std::set<long> predecessors;
+  for (const auto& k : c.keyframes) {
+    if (k.imu && k.imu->previous >= 0 && !predecessors.insert(k.imu->previous).second) {
+      fail(fmt::format("keyframe {} is the IMU predecessor of two keyframes", k.imu->previous));
     }
   }
 }
@@ -540,6 +627,15 @@ MapContents capture_map(const map::Map& map, const place::KeyframeDatabase* data
     std::sort(k.covisibility.begin(), k.covisibility.end());
     for (auto* other : kf->loop_edges()) {
       if (known(other)) k.loop_edges.push_back(other->id());
+    }
+    if (const auto imu = kf->imu()) {
+      SavedImuState s{imu->v, imu->bias, imu->estimated, -1, nullptr};
+      // A predecessor left out (culled meanwhile, or in another segment) starts the chain here.
+      if (known(imu->previous) && imu->from_previous) {
+        s.previous = imu->previous->id();
+        s.from_previous = imu->from_previous;
+      }
+      k.imu = s;
     }
     c.keyframes.push_back(std::move(k));
   }
@@ -609,6 +705,17 @@ std::string map_to_bytes(const MapContents& c) {
     for (const auto& k : c.keyframes) write_graph(w, k);
     payloads.push_back(std::move(w.str()));
   }
+  {
+    Writer w;
+    w.put<std::uint8_t>(c.meta.gravity_aligned);
+    std::size_t states = 0;
+    for (const auto& k : c.keyframes) states += k.imu.has_value();
+    w.put_count(states);
+    for (const auto& k : c.keyframes) {
+      if (k.imu) write_imu_state(w, k.id, *k.imu);
+    }
+    payloads.push_back(std::move(w.str()));
+  }
   Writer out;
   out.put_bytes(kMagic, sizeof(kMagic));
   out.put<std::uint32_t>(kMapFileVersion);
@@ -629,10 +736,13 @@ MapContents map_from_bytes(std::string_view bytes, const std::string& source, co
   std::uint32_t version, sections;
   std::memcpy(&version, bytes.data() + 8, 4);
   std::memcpy(&sections, bytes.data() + 12, 4);
-  if (version != kMapFileVersion) {
-    throw InputError(source, fmt::format("map format version {} (this plslam reads {})", version, kMapFileVersion));
+  if (version != 1 && version != kMapFileVersion) {
+    throw InputError(source, fmt::format("map format version {} (this plslam reads 1 to {})", version, kMapFileVersion));
   }
-  if (sections != 5) throw InputError(source, fmt::format("{} sections (expected 5)", sections));
+  const std::uint32_t expected_sections = version == 1 ? kVersion1Sections : kVersion1Sections + 1;
+  if (sections != expected_sections) {
+    throw InputError(source, fmt::format("{} sections (expected {} in version {})", sections, expected_sections, version));
+  }
   std::size_t at = 16;
   std::vector<Reader> readers;
   for (std::uint32_t i = 0; i < sections; ++i) {
@@ -659,6 +769,7 @@ MapContents map_from_bytes(std::string_view bytes, const std::string& source, co
 
   MapContents c;
   c.meta = read_meta(readers[0]);
+  c.meta.version = version;
   // The keyframes and the landmarks are independent sections: read side by side (about half the
   // time of a load each on the rendered loops).
   auto landmarks = std::async(std::launch::async, [&] {
@@ -691,6 +802,21 @@ MapContents map_from_bytes(std::string_view bytes, const std::string& source, co
     if (r.count(20) != c.keyframes.size()) r.fail("not one entry per keyframe");
     for (auto& k : c.keyframes) read_graph(r, k);
   }
+  if (version > 1) {
+    Reader& r = readers[5];
+    const auto aligned = r.get<std::uint8_t>();
+    if (aligned > 1) r.fail("bad gravity flag");
+    c.meta.gravity_aligned = aligned == 1;
+    const std::size_t n = r.count(8 + 9 * 8 + 1 + 8);
+    if (n > c.keyframes.size()) r.fail("more IMU states than keyframes");
+    std::size_t at = 0;  // states come by increasing keyframe id, as the keyframes
+    for (std::size_t i = 0; i < n; ++i) {
+      auto [id, state] = read_imu_state(r);
+      while (at < c.keyframes.size() && c.keyframes[at].id < id) ++at;
+      if (at == c.keyframes.size() || c.keyframes[at].id != id) r.fail(fmt::format("IMU state of unknown keyframe {} (or out of order)", id));
+      c.keyframes[at++].imu = std::move(state);
+    }
+  }
   for (auto& r : readers) {
     if (!r.done()) r.fail(fmt::format("{} bytes left after its records", r.left()));
   }
@@ -722,6 +848,16 @@ void restore_map(const MapContents& c, map::Map& map, place::KeyframeDatabase* d
       ml->add_observation(kfs.at(kf), index);
     }
     ml->restore_state(l.state);
+  }
+  // By increasing id: a predecessor's state is set before its successor's (set_imu links the two).
+  for (const auto& k : c.keyframes) {
+    if (!k.imu) continue;
+    map::KeyFrameImu imu{k.imu->v, k.imu->bias, nullptr, nullptr, k.imu->estimated};
+    if (k.imu->previous >= 0) {
+      imu.previous = kfs.at(k.imu->previous);
+      imu.from_previous = k.imu->from_previous;
+    }
+    kfs.at(k.id)->set_imu(imu);
   }
   for (const auto& k : c.keyframes) {
     map::IdMap<map::KeyFrame, int> weights;

@@ -2,14 +2,18 @@
 // The map file (.plmap): what a later run needs to relocalize in a map, track in it and keep
 // mapping it: the calibration, the vocabulary's identity, the configuration that built it, the
 // keyframes (pose, keypoints, descriptors, stereo depths, lines, bag of words), the map points and
-// lines (position, descriptor, viewing range, observations), and the covisibility graph, spanning
-// tree and loop edges. Only active objects are written; ids are kept.
+// lines (position, descriptor, viewing range, observations), the covisibility graph, spanning
+// tree and loop edges, and a stereo-inertial map's IMU states. Only active objects are written;
+// ids are kept.
 //
 // Format, little-endian:
-//   header   char[8] "plslmap\0", u32 version (1), u32 section count (5)
+//   header   char[8] "plslmap\0", u32 version (2; 1 is read too), u32 section count (6; 5 in version 1)
 //   section  char[4] tag, u64 payload bytes, u64 checksum of the payload, payload
 //   sections META (calibration, vocabulary identity, next ids, ground-truth anchor, config text), KFRM (keyframes),
-//            MPTS (map points), MLIN (map lines), GRPH (covisibility, parent, loop edges), in order.
+//            MPTS (map points), MLIN (map lines), GRPH (covisibility, parent, loop edges), in order;
+//            version 2 adds IMUS (whether the world's z axis is up; per keyframe with an IMU state:
+//            velocity, biases, the keyframe before it in the IMU chain and the IMU samples between
+//            the two with the bias and noise they were integrated with).
 // The checksum is FNV-1a 64 taken over 8-byte words (then the tail bytes): a flipped bit anywhere
 // changes it, at a byte-wise FNV's strength and 8x its speed.
 //
@@ -32,13 +36,14 @@
 
 #include "plslam/core/types.h"
 #include "plslam/geometry/se3.h"
+#include "plslam/inertial/preintegration.h"
 #include "plslam/map/frame_data.h"
 #include "plslam/map/map.h"
 #include "plslam/place/keyframe_database.h"
 
 namespace plslam::system {
 
-inline constexpr std::uint32_t kMapFileVersion = 1;
+inline constexpr std::uint32_t kMapFileVersion = 2;
 
 struct MapFileMeta {
   std::uint32_t version = kMapFileVersion;
@@ -55,6 +60,18 @@ struct MapFileMeta {
   std::optional<geometry::SE3> T_gt_map;
   std::string created_by;  // plslam version and the dataset
   std::string config;      // the configuration that built the map (YAML)
+  // The world's z axis points up (a stereo-inertial run turned it to gravity): a later run with an
+  // IMU can use it as it is. False in version 1 files.
+  bool gravity_aligned = false;
+};
+
+// A keyframe's IMU state (map::KeyFrameImu) with its predecessor by id.
+struct SavedImuState {
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  inertial::ImuBias bias;
+  bool estimated = false;
+  long previous = -1;  // keyframe id; -1: the chain starts here
+  std::shared_ptr<const inertial::Preintegration> from_previous;  // set with `previous`
 };
 
 struct SavedKeyframe {
@@ -65,6 +82,7 @@ struct SavedKeyframe {
   long parent = -1;                                      // -1: a spanning-tree root
   std::vector<std::pair<long, int>> covisibility;        // keyframe id, weight; by id
   std::vector<long> loop_edges;
+  std::optional<SavedImuState> imu;
 };
 
 // A map point (a = position) or a map line (a = start, b = end).

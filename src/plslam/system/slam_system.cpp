@@ -5,6 +5,7 @@
 #include "plslam/core/thread_priority.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <chrono>
 
@@ -221,24 +222,43 @@ void System::set_imu(const ImuData& imu, ImuInitMonitorOptions options) {
 }
 
 void System::align_world_with_gravity(long frame_id) {
-  if (map_loaded_ || gravity_alignment_ || !imu_init_ || !imu_init_->initialised()) return;
+  if (gravity_alignment_ || loaded_map_imu_ || !imu_init_ || !imu_init_->initialised()) return;
+  // A loaded map's world is the map file's: a stereo map's stays as it is (and the run stereo).
+  if (map_loaded_ && !loaded_map_gravity_aligned_) return;
   if (!mapper_->try_pause()) return;
   if (!loop_closer_ || loop_closer_->try_pause()) {
-    // About the origin (the first keyframe's camera centre): only the tilt changes.
-    const geometry::SE3 T_new_old(imu_init_->result()->R_gw(), Eigen::Vector3d::Zero());
-    map_.transform_world(T_new_old);
-    tracker_->transform_world(T_new_old);
-    gravity_alignment_ = GravityAlignment{T_new_old.rotation(), frame_id};
-    // The IMU's residuals assume gravity along -z: from here on tracking and local BA use them.
-    if (options_.visual_inertial) {
-      tracker_->use_imu(*imu_data_, imu_init_->result()->bias);
-      const geometry::SE3 T_imu_cam(imu_data_->T_imu_cam);
-      mapper_->use_imu(T_imu_cam);
-      if (loop_closer_) loop_closer_->use_imu(T_imu_cam);
+    const Eigen::Matrix3d R_gw = imu_init_->result()->R_gw();
+    if (map_loaded_) {
+      // The loaded map's z axis is up already; this run's gravity must agree with it.
+      const Eigen::Vector3d up = R_gw.transpose() * Eigen::Vector3d::UnitZ();
+      const double tilt_deg = std::acos(std::clamp(up.z(), -1.0, 1.0)) * 180 / M_PI;
+      loaded_map_imu_ = LoadedMapImu{tilt_deg, frame_id};
+      if (tilt_deg <= kMaxLoadedMapTiltDeg) {
+        start_visual_inertial();
+      } else {
+        spdlog::warn("imu: this run's gravity is {:.2f} deg from the loaded map's up direction (at most {:.1f}): "
+                     "tracking stays stereo", tilt_deg, kMaxLoadedMapTiltDeg);
+      }
+    } else {
+      // About the origin (the first keyframe's camera centre): only the tilt changes.
+      const geometry::SE3 T_new_old(R_gw, Eigen::Vector3d::Zero());
+      map_.transform_world(T_new_old);
+      tracker_->transform_world(T_new_old);
+      gravity_alignment_ = GravityAlignment{T_new_old.rotation(), frame_id};
+      start_visual_inertial();
     }
     if (loop_closer_) loop_closer_->resume();
   }
   mapper_->resume();
+}
+
+void System::start_visual_inertial() {
+  // The IMU's residuals assume gravity along -z: from here on tracking and local BA use them.
+  if (!options_.visual_inertial) return;
+  tracker_->use_imu(*imu_data_, imu_init_->result()->bias);
+  const geometry::SE3 T_imu_cam(imu_data_->T_imu_cam);
+  mapper_->use_imu(T_imu_cam);
+  if (loop_closer_) loop_closer_->use_imu(T_imu_cam);
 }
 
 nlohmann::json System::imu_report() const {
@@ -251,12 +271,15 @@ nlohmann::json System::imu_report() const {
   } else {
     world["kept"] = map_loaded_ ? "the loaded map's" : "the first keyframe's camera";
   }
+  if (map_loaded_) world["loaded_map_gravity_aligned"] = loaded_map_gravity_aligned_;
+  if (loaded_map_imu_) world["loaded_map_tilt_deg"] = loaded_map_imu_->tilt_deg;
   j["world"] = world;
   const bool inertial = tracker_->imu_on();
   nlohmann::json slam = {{"mode", inertial ? "stereo-inertial" : "stereo"},
                          {"imu_tracked_frames", tracker_->imu_tracked_frames()},
                          {"inertial_frames", tracker_->inertial_frames()}};
   if (gravity_alignment_ && inertial) slam["from_frame"] = gravity_alignment_->from_frame;
+  if (loaded_map_imu_ && inertial) slam["from_frame"] = loaded_map_imu_->from_frame;
   if (const auto bias = final_imu_bias()) {
     slam["final_gyro_bias"] = {bias->gyro.x(), bias->gyro.y(), bias->gyro.z()};
     slam["final_acc_bias"] = {bias->acc.x(), bias->acc.y(), bias->acc.z()};
@@ -471,11 +494,13 @@ void System::load_map(const MapContents& contents) {
     restore_map(contents, map_, database_.get());
   }
   map_loaded_ = true;
+  loaded_map_gravity_aligned_ = contents.meta.gravity_aligned;
   tracker_->start_in_loaded_map();
 }
 
 MapContents System::capture_map(MapFileMeta meta) const {
   meta.calib = calib_;
+  meta.gravity_aligned = gravity_alignment_.has_value() || (map_loaded_ && loaded_map_gravity_aligned_);
   if (database_) {
     meta.vocabulary_checksum = database_->vocabulary().checksum();
     meta.vocabulary_words = static_cast<std::uint32_t>(database_->vocabulary().size());

@@ -203,8 +203,11 @@ class System {
   bool deterministic() const;
   // Turns the world to the accepted initialisation's gravity-aligned one (set_imu()) if every
   // other thread is at rest: local mapping and loop closing idle and held paused, no global BA.
-  // `frame_id`: the first frame tracked in the turned world.
+  // `frame_id`: the first frame tracked in the turned world. A loaded gravity-aligned map is not
+  // turned: the run goes stereo-inertial in it if the two up directions agree.
   void align_world_with_gravity(long frame_id);
+  // Tracking, local mapping and loop closing use the IMU from here on (options_.visual_inertial).
+  void start_visual_inertial();
 
   SystemOptions options_;
   map::Map map_;
@@ -241,6 +244,16 @@ class System {
   WaitStats global_ba_waits_;
   std::vector<long> global_ba_merge_frames_;
   bool map_loaded_ = false;
+  bool loaded_map_gravity_aligned_ = false;  // the loaded map file says its z axis is up
+  // A gravity-aligned loaded map met this run's IMU initialisation: how far the two up directions
+  // were apart, and from which frame. Within kMaxLoadedMapTiltDeg (the initialisation's gravity
+  // is within ~0.5 deg, the map's too) the run goes stereo-inertial in the map's world as it is.
+  struct LoadedMapImu {
+    double tilt_deg = 0;
+    long from_frame = 0;
+  };
+  static constexpr double kMaxLoadedMapTiltDeg = 2.0;
+  std::optional<LoadedMapImu> loaded_map_imu_;
   std::optional<ImuData> imu_data_;  // the monitor refers to it
   std::optional<ImuInitMonitor> imu_init_;
   std::optional<GravityAlignment> gravity_alignment_;

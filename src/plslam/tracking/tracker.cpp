@@ -65,6 +65,7 @@ Tracker::Tracker(map::Map& map, TrackerOptions options, std::function<void(map::
 void Tracker::start_in_loaded_map() {
   if (!records_.empty()) throw std::logic_error("Tracker::start_in_loaded_map after the first frame");
   state_ = TrackingState::kLost;
+  own_keyframes_from_ = map_.next_ids().keyframe;
 }
 
 double Tracker::close_depth(const Frame& f) const {

@@ -247,7 +247,7 @@ class Tracker {
   // the next frame that can. Not owned; must outlive the tracker.
   void set_keyframe_database(const place::KeyframeDatabase* database) { database_ = database; }
   // The map was loaded from a file: the first frame is relocalized in it instead of starting a
-  // map (call before the first frame).
+  // map (call before the first frame). Its keyframes stay out of this run's IMU chain.
   void start_in_loaded_map();
 
   int lost_events() const { return lost_events_; }
@@ -430,6 +430,9 @@ class Tracker {
   std::optional<double> last_visual_t_;  // the last frame vision tracked
   // The IMU chain reaches the current frame: tracked without a loss since its last keyframe.
   bool imu_chain_live_ = false;
+  // Keyframes with lower ids were loaded from a map file: their times are another run's clock,
+  // so the IMU chain never links to them.
+  long own_keyframes_from_ = 0;
   int imu_tracked_frames_ = 0;
   int inertial_frames_ = 0;
 };

@@ -37,7 +37,9 @@ void Tracker::use_imu(const ImuData& imu, const inertial::ImuBias& bias) {
   // The chain starts with the last keyframes of the current segment, in time order.
   std::vector<map::KeyFrame*> chain;
   for (map::KeyFrame* kf : map_.keyframes()) {
-    if (kf->segment() == last_keyframe_->segment() && kf->id() <= last_keyframe_->id()) chain.push_back(kf);
+    if (kf->segment() == last_keyframe_->segment() && kf->id() >= own_keyframes_from_ && kf->id() <= last_keyframe_->id()) {
+      chain.push_back(kf);
+    }
   }
   const auto n = static_cast<std::size_t>(std::max(1, options_.imu.seed_keyframes));
   if (chain.size() > n) chain.erase(chain.begin(), chain.end() - static_cast<std::ptrdiff_t>(n));
@@ -70,7 +72,9 @@ std::optional<Tracker::ImuPrior> Tracker::imu_prior(const Frame& f) const {
     kf = state->previous;
     state = kf->imu();
   }
-  if (!state || !state->estimated || t - kf->timestamp() > options_.imu.max_prediction_s) return std::nullopt;
+  if (!state || !state->estimated || kf->id() < own_keyframes_from_ || t - kf->timestamp() > options_.imu.max_prediction_s) {
+    return std::nullopt;
+  }
   const double t_kf = kf->timestamp();
   if (!(t > t_kf)) return std::nullopt;
   ImuPrior prior;
@@ -99,7 +103,7 @@ map::KeyFrameImu Tracker::keyframe_imu(const Frame& f, bool chained) const {
     }
   }
   map::KeyFrame* previous = last_keyframe_;
-  if (chained && previous && !previous->is_bad()) {
+  if (chained && previous && !previous->is_bad() && previous->id() >= own_keyframes_from_) {
     if (const auto before = previous->imu()) {
       s.from_previous = preintegrate(*imu_, previous->timestamp(), f.data->timestamp, before->bias);
       if (s.from_previous) s.previous = previous;
