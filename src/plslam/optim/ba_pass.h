@@ -40,6 +40,10 @@ struct BaPassSpec {
   const BaExclusions* excluded = nullptr;  // null: every observation takes part
 };
 
+// spec's exclusions plus the observations whose landmark is behind its camera at s: Ceres refuses
+// to start from them, the Schur backend leaves them out of the pass; the final gate flags them.
+BaExclusions with_behind_camera(const BaProblem& p, const BaPassSpec& spec, const BaState& s);
+
 BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& p,
                             const BaOptions& opt, const BaPassSpec& spec, BaState* s);
 

@@ -86,34 +86,6 @@ struct Context {
   bool robust;
 };
 
-// Sum of rho over the observation's robust blocks; false when a point is behind the camera.
-bool residual(const Context& c, const StereoPointObservation& o, double info, const SE3& T,
-              const Eigen::Vector3d& X, double* rho) {
-  Eigen::Vector3d r;
-  if (!evaluate_stereo_point(c.cam, T, X, o.measurement, o.has_right, &r, nullptr, nullptr)) {
-    return false;
-  }
-  const double s = info * r.squaredNorm();
-  const Huber h{o.has_right ? c.opt.chi2_point_stereo : c.opt.chi2_point_mono};
-  *rho = c.robust ? h.rho(s) : s;
-  return true;
-}
-
-bool residual(const Context& c, const StereoLineObservation& o, double info, const SE3& T,
-              const Vector6d& L, double* rho) {
-  Eigen::Vector4d r;
-  if (!evaluate_stereo_line(c.cam, T, L.head<3>(), L.tail<3>(), o, &r, nullptr, nullptr, nullptr)) {
-    return false;
-  }
-  const Huber h{c.opt.chi2_line_pair};
-  *rho = 0.0;
-  for (int pair = 0; pair < 2; ++pair) {  // left image rows 0-1, right image rows 2-3
-    const double s = info * r.segment<2>(2 * pair).squaredNorm();
-    *rho += c.robust ? h.rho(s) : s;
-  }
-  return true;
-}
-
 // A point observation linearised through its projection Jacobian A = d(projection)/d(X_c):
 // J_pose = A [I, -hat(X_c)] and J_point = A R, so with B = w A'A and a = w A'r every block of the
 // normal equations is a 3x3 product or a few cross products (add_pose_normal_equations):
@@ -834,26 +806,7 @@ double SchurLm::step_norm() const {
   return std::sqrt(sq);
 }
 
-BaExclusions SchurLm::exclusions_with_invalid() const {
-  BaExclusions ex;
-  ex.point_out.assign(p_.point_observations.size(), false);
-  ex.line_out.assign(p_.line_observations.size(), false);
-  if (spec_.excluded) ex = *spec_.excluded;
-  double rho = 0.0;
-  for (std::size_t k = 0; k < p_.point_observations.size(); ++k) {
-    const auto& o = p_.point_observations[k];
-    ex.point_out[k] = ex.point_out[k] ||
-                      !residual(ctx_, o, 1.0, s_->poses[static_cast<std::size_t>(o.keyframe)],
-                                s_->points[static_cast<std::size_t>(o.point)], &rho);
-  }
-  for (std::size_t k = 0; k < p_.line_observations.size(); ++k) {
-    const auto& o = p_.line_observations[k];
-    ex.line_out[k] = ex.line_out[k] ||
-                     !residual(ctx_, o, 1.0, s_->poses[static_cast<std::size_t>(o.keyframe)],
-                               s_->lines[static_cast<std::size_t>(o.line)], &rho);
-  }
-  return ex;
-}
+BaExclusions SchurLm::exclusions_with_invalid() const { return with_behind_camera(p_, spec_, *s_); }
 
 BaPassSummary SchurLm::run() {
   BaPassSummary out;

@@ -77,28 +77,6 @@ BaExclusions gate(const geometry::StereoCamera& cam, const BaProblem& p, const B
   return g;
 }
 
-// spec's exclusions plus the observations whose landmark is behind its camera at s: Ceres refuses
-// to start from them, the Schur backend leaves them out of the pass; the final gate flags them.
-BaExclusions with_behind_camera(const BaProblem& p, const BaPassSpec& spec,
-                                const BaState& s) {
-  BaExclusions ex;
-  if (spec.excluded) ex = *spec.excluded;
-  ex.point_out.resize(p.point_observations.size(), false);
-  ex.line_out.resize(p.line_observations.size(), false);
-  for (std::size_t k = 0; k < p.point_observations.size(); ++k) {
-    const auto& o = p.point_observations[k];
-    const Eigen::Vector3d Xc = s.poses[static_cast<std::size_t>(o.keyframe)] * s.points[static_cast<std::size_t>(o.point)];
-    if (!(Xc.z() > 0.0)) ex.point_out[k] = true;
-  }
-  for (std::size_t k = 0; k < p.line_observations.size(); ++k) {
-    const auto& o = p.line_observations[k];
-    const auto& T = s.poses[static_cast<std::size_t>(o.keyframe)];
-    const auto& L = s.lines[static_cast<std::size_t>(o.line)];
-    if (!((T * Eigen::Vector3d(L.head<3>())).z() > 0.0) || !((T * Eigen::Vector3d(L.tail<3>())).z() > 0.0)) ex.line_out[k] = true;
-  }
-  return ex;
-}
-
 BaPassSummary run_pass(const geometry::StereoCamera& cam, const BaProblem& p,
                        const BaOptions& opt, const BaPassSpec& spec, BaState* s) {
   if (opt.backend == BaBackend::kSchurLM) {
@@ -118,6 +96,26 @@ BaPassSummary run_pass(const geometry::StereoCamera& cam, const BaProblem& p,
 }
 
 }  // namespace
+
+BaExclusions with_behind_camera(const BaProblem& p, const BaPassSpec& spec,
+                                const BaState& s) {
+  BaExclusions ex;
+  if (spec.excluded) ex = *spec.excluded;
+  ex.point_out.resize(p.point_observations.size(), false);
+  ex.line_out.resize(p.line_observations.size(), false);
+  for (std::size_t k = 0; k < p.point_observations.size(); ++k) {
+    const auto& o = p.point_observations[k];
+    const Eigen::Vector3d Xc = s.poses[static_cast<std::size_t>(o.keyframe)] * s.points[static_cast<std::size_t>(o.point)];
+    if (!(Xc.z() > 0.0)) ex.point_out[k] = true;
+  }
+  for (std::size_t k = 0; k < p.line_observations.size(); ++k) {
+    const auto& o = p.line_observations[k];
+    const auto& T = s.poses[static_cast<std::size_t>(o.keyframe)];
+    const auto& L = s.lines[static_cast<std::size_t>(o.line)];
+    if (!((T * Eigen::Vector3d(L.head<3>())).z() > 0.0) || !((T * Eigen::Vector3d(L.tail<3>())).z() > 0.0)) ex.line_out[k] = true;
+  }
+  return ex;
+}
 
 BaResult bundle_adjust(const geometry::StereoCamera& cam, const BaProblem& p,
                        const BaOptions& opt) {
