@@ -1,5 +1,6 @@
 // The Ceres backend of bundle_adjust: analytic costs of ceres_costs.h, landmarks in elimination
 // group 0 so DENSE_SCHUR / SPARSE_SCHUR eliminate them first.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -123,10 +124,31 @@ class KeyframeFactorCost final : public ceres::CostFunction {
 
 BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& p,
                             const BaOptions& opt, const BaPassSpec& spec, BaState* s) {
-  // Ceres works on 7-number pose blocks in place.
-  std::vector<PoseParams> poses;
-  poses.reserve(s->poses.size());
-  for (const auto& T : s->poses) poses.push_back(to_params(T));
+  // Every block lives in one buffer, laid out in the problem's order: per keyframe its pose (7
+  // numbers, as Ceres moves them) and its extra state (9), then the points, then the lines. Ceres
+  // orders the blocks of an elimination group by their address, and so its elimination order and
+  // its rounding; with the blocks in separate vectors that order followed the heap, and two runs
+  // of one binary differed in the 11th digit.
+  constexpr std::size_t kPose = 7, kExtra = 9, kPoint = 3, kLine = 6;
+  const std::size_t n_kf = s->poses.size();
+  const bool with_extra = !p.keyframe_factors.empty();
+  const std::size_t per_kf = kPose + (with_extra ? kExtra : 0);
+  const std::size_t points_at = n_kf * per_kf;
+  const std::size_t lines_at = points_at + kPoint * s->points.size();
+  std::vector<double> buffer(lines_at + kLine * s->lines.size());
+  auto pose_block = [&](std::size_t k) { return buffer.data() + k * per_kf; };
+  auto extra_block = [&](std::size_t k) { return buffer.data() + k * per_kf + kPose; };
+  auto point_block = [&](std::size_t k) { return buffer.data() + points_at + kPoint * k; };
+  auto line_block = [&](std::size_t k) { return buffer.data() + lines_at + kLine * k; };
+  for (std::size_t k = 0; k < n_kf; ++k) {
+    const PoseParams q = to_params(s->poses[k]);
+    std::copy(q.begin(), q.end(), pose_block(k));
+    if (with_extra) Eigen::Map<Vector9d>(extra_block(k)) = s->extra[k];
+  }
+  for (std::size_t k = 0; k < s->points.size(); ++k) Eigen::Map<Eigen::Vector3d>(point_block(k)) = s->points[k];
+  for (std::size_t k = 0; k < s->lines.size(); ++k) {
+    Eigen::Map<Eigen::Matrix<double, 6, 1>>(line_block(k)) = s->lines[k];
+  }
 
   SE3LeftManifold manifold;
   ceres::HuberLoss point_loss(std::sqrt(opt.chi2_point_stereo));
@@ -142,7 +164,7 @@ BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& 
   std::vector<bool> pose_added(p.keyframes.size(), false);
   auto add_pose = [&](int kf) {
     const auto k = static_cast<std::size_t>(kf);
-    double* x = poses[k].data();
+    double* x = pose_block(k);
     if (!pose_added[k]) {
       pose_added[k] = true;
       problem.AddParameterBlock(x, 7, &manifold);
@@ -174,11 +196,11 @@ BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& 
     const auto& o = p.point_observations[k];
     const auto pi = static_cast<std::size_t>(o.point);
     double* pose = add_pose(o.keyframe);
-    add_landmark(s->points[pi].data(), 3, p.points[pi].fixed, point_added, pi);
+    double* point = point_block(pi);
+    add_landmark(point, 3, p.points[pi].fixed, point_added, pi);
     const double sqrt_info = std::sqrt(level_information(o.level, opt.scale_factor));
     ceres::LossFunction* loss = spec.robust ? (o.has_right ? &point_loss : &mono_loss) : nullptr;
-    problem.AddResidualBlock(new StereoPointCost(cam, o, sqrt_info), loss, pose,
-                             s->points[pi].data());
+    problem.AddResidualBlock(new StereoPointCost(cam, o, sqrt_info), loss, pose, point);
   }
   std::vector<bool> line_added(p.lines.size(), false);
   for (std::size_t k = 0; k < p.line_observations.size(); ++k) {
@@ -186,13 +208,13 @@ BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& 
     const auto& o = p.line_observations[k];
     const auto li = static_cast<std::size_t>(o.line);
     double* pose = add_pose(o.keyframe);
-    add_landmark(s->lines[li].data(), 6, p.lines[li].fixed, line_added, li);
+    double* line = line_block(li);
+    add_landmark(line, 6, p.lines[li].fixed, line_added, li);
     const double sqrt_info =
         std::sqrt(o.information * level_information(o.level, opt.scale_factor));
     ceres::LossFunction* loss = spec.robust ? &line_loss : nullptr;
     for (const bool right : {false, true}) {
-      problem.AddResidualBlock(new StereoLinePairCost(cam, o, right, sqrt_info), loss, pose,
-                               s->lines[li].data());
+      problem.AddResidualBlock(new StereoLinePairCost(cam, o, right, sqrt_info), loss, pose, line);
     }
   }
 
@@ -203,7 +225,7 @@ BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& 
     for (const int kf : f->keyframes()) {
       blocks.push_back(add_pose(kf));
       const auto k = static_cast<std::size_t>(kf);
-      double* x = s->extra[k].data();
+      double* x = extra_block(k);
       if (!extra_added[k]) {
         extra_added[k] = true;
         problem.AddParameterBlock(x, 9);
@@ -234,8 +256,15 @@ BaPassSummary ceres_ba_pass(const geometry::StereoCamera& cam, const BaProblem& 
   if (opt.abort) so.callbacks.push_back(&abort_callback);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    if (pose_added[k] && !p.keyframes[k].fixed) s->poses[k] = from_params(poses[k].data());
+  for (std::size_t k = 0; k < n_kf; ++k) {
+    if (pose_added[k] && !p.keyframes[k].fixed) s->poses[k] = from_params(pose_block(k));
+    if (extra_added[k]) s->extra[k] = Eigen::Map<const Vector9d>(extra_block(k));
+  }
+  for (std::size_t k = 0; k < s->points.size(); ++k) {
+    if (point_added[k]) s->points[k] = Eigen::Map<const Eigen::Vector3d>(point_block(k));
+  }
+  for (std::size_t k = 0; k < s->lines.size(); ++k) {
+    if (line_added[k]) s->lines[k] = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(line_block(k));
   }
   out.initial_cost = summary.initial_cost;
   out.final_cost = summary.final_cost;
