@@ -125,7 +125,7 @@ int run_bench_features(const BenchFeaturesArgs& args) {
   return 0;
 }
 
-CommandRegistration reg({"bench", "Benchmarks: front-end stages (features), whole-system experiments (slam)", [](CLI::App& sub) {
+CommandRegistration register_bench_command({"bench", "Benchmarks: front-end stages (features), whole-system experiments (slam)", [](CLI::App& sub) {
                            sub.require_subcommand(1);
                            auto args = std::make_shared<BenchFeaturesArgs>();
                            CLI::App* features = sub.add_subcommand("features", "Point and line features: per-stage ms, counts, uniformity, whole-frame ms");

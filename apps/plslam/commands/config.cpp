@@ -49,7 +49,7 @@ int run_config_keys(bool json) {
   return 0;
 }
 
-CommandRegistration reg({"config", "The configuration keys of plslam run", [](CLI::App& sub) {
+CommandRegistration register_config_command({"config", "The configuration keys of plslam run", [](CLI::App& sub) {
                            sub.require_subcommand(1);
                            auto json = std::make_shared<bool>(false);
                            CLI::App* keys = sub.add_subcommand(

@@ -121,7 +121,7 @@ int run(const Options& o) {
   return 0;
 }
 
-plslam::cli::CommandRegistration reg({"eval", "Evaluate an estimated trajectory against ground truth (APE, RPE, KITTI metric)",
+plslam::cli::CommandRegistration register_eval_command({"eval", "Evaluate an estimated trajectory against ground truth (APE, RPE, KITTI metric)",
   [](CLI::App& sub) {
     auto o = std::make_shared<Options>();
     const std::vector<std::string> formats = {"tum", "kitti", "euroc", "auto"};

@@ -127,7 +127,7 @@ int run_info(const InfoArgs& args) {
   return 0;
 }
 
-CommandRegistration reg({"info", "Describe a stereo dataset (format, frames, calibration, ground truth, IMU)",
+CommandRegistration register_info_command({"info", "Describe a stereo dataset (format, frames, calibration, ground truth, IMU)",
                          [](CLI::App& sub) {
                            auto args = std::make_shared<InfoArgs>();
                            add_dataset_options(sub, args->dataset, "--max-frames", false);

@@ -195,7 +195,7 @@ int run_map_export(const MapExportArgs& args) {
   return 0;
 }
 
-CommandRegistration reg({"map", "Inspect and export a saved map (.plmap)", [](CLI::App& sub) {
+CommandRegistration register_map_command({"map", "Inspect and export a saved map (.plmap)", [](CLI::App& sub) {
                            sub.require_subcommand(1);
                            auto info_args = std::make_shared<MapInfoArgs>();
                            CLI::App* info = sub.add_subcommand("info", "Counts, extent, calibration, vocabulary and config");

@@ -557,7 +557,7 @@ int run_repeated(const RunArgs& args) {
   return rc;
 }
 
-CommandRegistration reg({"run", "Run stereo point-line SLAM on a sequence", [](CLI::App& sub) {
+CommandRegistration register_run_command({"run", "Run stereo point-line SLAM on a sequence", [](CLI::App& sub) {
                            auto args = std::make_shared<RunArgs>();
                            add_dataset_options(sub, args->dataset, "--max-frames", false);
                            sub.add_option("--out", args->out, "Output folder")->required();

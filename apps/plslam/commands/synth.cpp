@@ -155,7 +155,7 @@ int run(const Options& o) {
   return 0;
 }
 
-plslam::cli::CommandRegistration reg({"synth", "Render a synthetic stereo sequence with exact ground truth",
+plslam::cli::CommandRegistration register_synth_command({"synth", "Render a synthetic stereo sequence with exact ground truth",
                                       [](CLI::App& sub) {
                                         auto o = std::make_shared<Options>();
                                         sub.add_option("--out", o->out, "Output folder")->required();

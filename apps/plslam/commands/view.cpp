@@ -47,7 +47,7 @@ int run_view(const ViewArgs& args) {
   return 0;
 }
 
-CommandRegistration reg({"view", "Serve the browser map viewer for a run folder or a saved map",
+CommandRegistration register_view_command({"view", "Serve the browser map viewer for a run folder or a saved map",
                          [](CLI::App& sub) {
                            auto args = std::make_shared<ViewArgs>();
                            sub.add_option("target", args->target, "A folder `plslam run --out` wrote, or a .plmap")

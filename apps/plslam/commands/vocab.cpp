@@ -240,7 +240,7 @@ int run_vocab_eval(const VocabEvalArgs& args) {
   return 0;
 }
 
-CommandRegistration reg({"vocab", "Train plslam's visual vocabulary (bag of words for place recognition)",
+CommandRegistration register_vocab_command({"vocab", "Train plslam's visual vocabulary (bag of words for place recognition)",
                          [](CLI::App& sub) {
                            sub.require_subcommand(1);
                            auto args = std::make_shared<VocabTrainArgs>();
