@@ -56,7 +56,8 @@ TEST(BenchSlamCli, QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequen
   EXPECT_EQ(read_json(seq / "report.json"), report);
   std::vector<std::string> names;
   for (const auto& c : report["configurations"]) names.push_back(c["name"]);
-  EXPECT_EQ(names, (std::vector<std::string>{"full", "no-lines", "quadtree", "no-pid", "no-kalman", "no-loop-closing"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"full", "no-lines", "quadtree", "no-pid", "no-kalman", "no-loop-closing",
+                                             "stereo-inertial", "stereo"}));
   ASSERT_EQ(report["datasets"].size(), 1u);
   const json& s = report["summary"]["office-quick"];
   for (const auto& name : names) {
@@ -72,6 +73,8 @@ TEST(BenchSlamCli, QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequen
   EXPECT_GT(s["full"]["map_lines"]["median"].get<double>(), 0.0);
   EXPECT_LT(s["full"]["ate_m"]["median"].get<double>(), 0.02);
   EXPECT_TRUE(s["no-lines"]["ratio_to_full"]["ate_m"].is_number());
+  EXPECT_TRUE(s["stereo-inertial"]["ratio_to_stereo"]["ate_m"].is_number());
+  EXPECT_EQ(s["stereo"]["imu_share"]["median"].get<double>(), 0.0);
   // Table I and the figures exist and are named in the report.
   const json& t1 = report["table1"]["office-quick"];
   EXPECT_GT(t1["quadtree_ms"].get<double>(), 0.0);
@@ -87,6 +90,7 @@ TEST(BenchSlamCli, QuickPresetReportsEveryConfigurationAndMetricAsSeparateSequen
   const auto md = test::read_file(seq / "report.md");
   for (const auto& name : names) EXPECT_NE(md.find("| " + name + " |"), std::string::npos) << name;
   EXPECT_NE(md.find("Table I"), std::string::npos);
+  EXPECT_NE(md.find("Stereo-inertial against stereo: "), std::string::npos);
   EXPECT_NE(report["command"].get<std::string>().find("--preset quick --runs 1 --sequential --table1-frames 3 --out "),
             std::string::npos)
       << report["command"];

@@ -63,7 +63,8 @@ TEST(SlamBenchPlan, AnchorRowsFollowTheConfigurationsWithAnOdometryTwinWhenAsked
   EXPECT_TRUE(rows[all.size()].loop_closing);
   EXPECT_EQ(rows.back().name, "anchor-no-loop-closing");
   EXPECT_FALSE(rows.back().loop_closing);
-  EXPECT_FALSE(rows[all.size() - 1].loop_closing);  // no-loop-closing
+  EXPECT_FALSE(rows[5].loop_closing);  // no-loop-closing
+  EXPECT_TRUE(rows[all.size() - 1].loop_closing);  // stereo
   EXPECT_TRUE(rows[0].loop_closing);
   rows = bench_rows(select_slam_configurations("full,no-lines", all), "anchor");
   EXPECT_EQ(rows.size(), 3u);
@@ -90,7 +91,8 @@ TEST(SlamConfigurations, BuiltInsApplyToBothPresetsAndSelectionKeepsTheOrderGive
     names.push_back(c.name);
     EXPECT_NO_THROW(validate_slam_configuration(c, "builtin"));
   }
-  EXPECT_EQ(names, (std::vector<std::string>{"full", "no-lines", "quadtree", "no-pid", "no-kalman", "no-loop-closing"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"full", "no-lines", "quadtree", "no-pid", "no-kalman", "no-loop-closing",
+                                             "stereo-inertial", "stereo"}));
   const auto sel = select_slam_configurations("no-pid,full", all);
   ASSERT_EQ(sel.size(), 2u);
   EXPECT_EQ(sel[0].name, "no-pid");
@@ -152,7 +154,8 @@ TEST(SlamBenchScoring, ARunIsScoredLikePlslamEvalAndItsStatsAreRead) {
   io::write_trajectory(run / "trajectory.tum", est, io::TrajectoryFormat::kTum);
   write_text(run / "stats.json", R"({"input_frames": 100, "tracked_frames": 95, "lost_events": 1,
     "relocalizations": {"count": 1, "frames": [50]}, "loops": [{"frame": 90}], "keyframes": 12,
-    "map_points": 3000, "map_lines": 400, "tracking_ms": {"median": 21.5, "p90": 30.0}})");
+    "map_points": 3000, "map_lines": 400, "tracking_ms": {"median": 21.5, "p90": 30.0},
+    "imu": {"slam": {"mode": "stereo-inertial", "imu_tracked_frames": 60}}})");
   const json m = measure_run(ds, run, false);
   const auto expected = eval::evaluate(gt, io::read_trajectory(run / "trajectory.tum", io::TrajectoryFormat::kTum), {});
   ASSERT_TRUE(m["ate_m"].is_number()) << m.dump();
@@ -163,6 +166,7 @@ TEST(SlamBenchScoring, ARunIsScoredLikePlslamEvalAndItsStatsAreRead) {
   EXPECT_NEAR(m["rpe_frame_rot_deg"].get<double>(), 0.0, 1e-6);
   EXPECT_TRUE(m["rpe_1m_trans_m"].is_number());
   EXPECT_DOUBLE_EQ(m["tracked_share"].get<double>(), 0.95);
+  EXPECT_DOUBLE_EQ(m["imu_share"].get<double>(), 0.6);
   EXPECT_EQ(m["lost_events"], 1);
   EXPECT_EQ(m["relocalizations"], 1);
   EXPECT_EQ(m["loops"], 1);
@@ -184,6 +188,7 @@ TEST(SlamBenchScoring, AnAnchorsStatsAreReadFromItsOwnKeys) {
   const json m = measure_run(ds, run, true);
   EXPECT_NEAR(m["ate_m"].get<double>(), 0.0, 1e-9);
   EXPECT_DOUBLE_EQ(m["tracked_share"].get<double>(), 0.8);
+  EXPECT_TRUE(m["imu_share"].is_null());
   EXPECT_EQ(m["lost_events"], 3);
   EXPECT_EQ(m["relocalizations"], 1);
   EXPECT_EQ(m["loops"], 2);
@@ -202,6 +207,7 @@ TEST(SlamBenchScoring, ARunWithoutOutputsSaysWhyAndScoresNothing) {
   EXPECT_TRUE(m["ate_m"].is_null());
   EXPECT_NE(m["error"].get<std::string>().find("trajectory.tum"), std::string::npos);
   EXPECT_DOUBLE_EQ(m["tracked_share"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(m["imu_share"].get<double>(), 0.0);  // a plslam run without the IMU
 }
 
 TEST(SlamBenchSummary, MediansMinMaxAndRatiosUseSuccessfulRunsOnly) {
@@ -248,6 +254,43 @@ TEST(SlamBenchSummary, MediansMinMaxAndRatiosUseSuccessfulRunsOnly) {
   const auto md = format_report_markdown(report);
   EXPECT_NE(md.find("| full | 0.0200 (0.0100–0.0300) |"), std::string::npos) << md;
   EXPECT_NE(md.find("| 2 | 1 |"), std::string::npos) << md;  // no-lines: ATE / full, ATE / anchor
+}
+
+// The stereo-inertial row against the stereo one: ratios of the medians, and a line in the report.
+TEST(SlamBenchSummary, StereoInertialIsComparedWithStereo) {
+  const std::vector<BenchDataset> datasets = {{"d", "/d"}};
+  const auto rows = bench_rows(select_slam_configurations("stereo-inertial,stereo", builtin_slam_configurations()), "");
+  json results = json::array();
+  auto add = [&](const std::string& row, int run, double ate, double ms, double imu) {
+    json m = json::object();
+    for (const auto& k : bench_metrics()) m[k.key] = nullptr;
+    m["ate_m"] = ate;
+    m["tracking_ms_median"] = ms;
+    m["imu_share"] = imu;
+    results.push_back({{"dataset", "d"}, {"row", row}, {"run", run}, {"exit_code", 0}, {"metrics", m}});
+  };
+  add("stereo-inertial", 1, 0.006, 22, 0.8);
+  add("stereo-inertial", 2, 0.004, 23, 0.8);
+  add("stereo-inertial", 3, 0.005, 24, 0.8);
+  add("stereo", 1, 0.010, 20, 0.0);
+  add("stereo", 2, 0.008, 20, 0.0);
+  add("stereo", 3, 0.009, 21, 0.0);
+  const json s = summarize_runs(results, datasets, rows)["d"];
+  EXPECT_DOUBLE_EQ(s["stereo-inertial"]["ratio_to_stereo"]["ate_m"].get<double>(), 0.005 / 0.009);
+  EXPECT_DOUBLE_EQ(s["stereo-inertial"]["ratio_to_stereo"]["tracking_ms_median"].get<double>(), 23.0 / 20.0);
+  EXPECT_FALSE(s["stereo"].contains("ratio_to_stereo"));
+  EXPECT_FALSE(s["stereo-inertial"].contains("ratio_to_full"));  // no full row
+
+  json report = {{"rows", json::array()}, {"datasets", json::array({{{"name", "d"}, {"path", "/d"}, {"frames", 3}}})},
+                 {"configurations", json::array()}, {"summary", {{"d", s}}}, {"interrupted_by", nullptr}};
+  for (const auto& r : rows) report["rows"].push_back({{"name", r.name}, {"anchor", r.anchor}});
+  const auto md = format_report_markdown(report);
+  EXPECT_NE(md.find("Stereo-inertial against stereo: ATE 0.0050 (0.0040–0.0060) m against 0.0090 (0.0080–0.0100) m "
+                    "(0.556x), tracking 23.0 (22.0–24.0) ms against 20.0 (20.0–21.0) ms (1.15x); the IMU helped to "
+                    "track 80.0 % of the frames."),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| stereo-inertial |"), std::string::npos) << md;
 }
 
 TEST(SlamBenchFigures, FrameTimesComeFromFramesCsvOrTheAnchorsList) {

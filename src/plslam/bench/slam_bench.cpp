@@ -4,6 +4,7 @@
 #include <fstream>
 #include <functional>
 #include <set>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -76,6 +77,7 @@ const std::vector<MetricInfo>& bench_metrics() {
       {"rpe_1m_trans_m", "RPE 1 m m", 4},
       {"rpe_1m_rot_deg", "RPE 1 m deg", 3},
       {"tracked_share", "tracked %", 3},
+      {"imu_share", "IMU %", 3},
       {"lost_events", "lost", 0},
       {"relocalizations", "reloc", 0},
       {"loops", "loops", 0},
@@ -138,6 +140,9 @@ json measure_run(const io::Dataset& dataset, const fs::path& folder, bool anchor
     m["relocalizations"] = number_at(stats, {"relocalizations", "count"});
     m["loops"] = stats.contains("loops") && stats["loops"].is_array() ? json(stats["loops"].size()) : json(nullptr);
     m["map_lines"] = number_at(stats, {"map_lines"});
+    // Frames the IMU helped to track; 0 where it was off, absent or never initialised.
+    const json imu_frames = number_at(stats, {"imu", "slam", "imu_tracked_frames"});
+    if (frames.is_number() && frames.get<double>() > 0) m["imu_share"] = imu_frames.is_number() ? ratio(imu_frames, frames) : 0.0;
   }
   m["keyframes"] = number_at(stats, {"keyframes"});
   m["map_points"] = number_at(stats, {"map_points"});
@@ -221,6 +226,11 @@ json summarize_runs(const json& results, const std::vector<BenchDataset>& datase
                               {"tracking_ms_median", ratio(median_of(row.name, "tracking_ms_median"),
                                                            median_of("full", "tracking_ms_median"))}};
       }
+      if (row.name == "stereo-inertial" && per_row.contains("stereo")) {
+        s["ratio_to_stereo"] = {{"ate_m", ratio(median_of(row.name, "ate_m"), median_of("stereo", "ate_m"))},
+                                {"tracking_ms_median", ratio(median_of(row.name, "tracking_ms_median"),
+                                                             median_of("stereo", "tracking_ms_median"))}};
+      }
       if (!row.anchor) {
         // Against the anchor with the same loop-closing setting.
         for (const auto& a : rows) {
@@ -243,7 +253,7 @@ std::string cell(const json& s, const MetricInfo& k) {
   if (!s.is_object() || !s.contains(k.key) || !s[k.key].is_object()) return "–";
   const auto& v = s[k.key];
   const double med = v["median"].get<double>(), lo = v["min"].get<double>(), hi = v["max"].get<double>();
-  const bool share = std::string(k.key) == "tracked_share";
+  const bool share = std::string(k.key) == "tracked_share" || std::string(k.key) == "imu_share";
   const double f = share ? 100.0 : 1.0;
   const int dec = share ? 1 : k.decimals;
   if (v["n"].get<int>() == 1 || lo == hi) return fmt::format("{:.{}f}", med * f, dec);
@@ -321,6 +331,18 @@ std::string format_report_markdown(const json& report) {
                     return fmt::format("{}/{}", s.value("failed_runs", 0), s.value("runs", 0));
                   }}});
     md += "\n";
+    if (per_row.contains("stereo-inertial") && per_row["stereo-inertial"].contains("ratio_to_stereo")) {
+      const json& si = per_row["stereo-inertial"];
+      const json& st = per_row["stereo"];
+      auto metric = [&](std::string_view key) {
+        return *std::find_if(metrics.begin(), metrics.end(), [&](const MetricInfo& k) { return k.key == key; });
+      };
+      const MetricInfo ate = metric("ate_m"), ms = metric("tracking_ms_median"), imu = metric("imu_share");
+      md += "Stereo-inertial against stereo: ATE " + cell(si, ate) + " m against " + cell(st, ate) + " m (" +
+            ratio_cell(si, "ratio_to_stereo", "ate_m") + "x), tracking " + cell(si, ms) + " ms against " + cell(st, ms) +
+            " ms (" + ratio_cell(si, "ratio_to_stereo", "tracking_ms_median") + "x); the IMU helped to track " +
+            cell(si, imu) + " % of the frames.\n\n";
+    }
     if (report.contains("figures") && report["figures"].contains(name)) {
       for (const auto& f : report["figures"][name]) md += fmt::format("![{0}]({0})\n", f.get<std::string>());
       md += "\n";

@@ -53,7 +53,7 @@ std::filesystem::path run_folder(const std::filesystem::path& out, const BenchDa
 
 // Scores one finished run folder (trajectory.tum, stats.json; frames.csv or frame_times_ms.txt)
 // against the dataset's ground truth: ate_m, rpe_frame_trans_m, rpe_frame_rot_deg, rpe_1m_trans_m,
-// rpe_1m_rot_deg, tracked_share, lost_events, relocalizations, loops, keyframes, map_points,
+// rpe_1m_rot_deg, tracked_share, imu_share (plslam: frames tracked with the IMU), lost_events, relocalizations, loops, keyframes, map_points,
 // map_lines, tracking_ms_median, tracking_ms_p90. A value the run does not provide is null;
 // "error" says why a run has no score.
 nlohmann::json measure_run(const io::Dataset& dataset, const std::filesystem::path& folder, bool anchor);
@@ -68,7 +68,8 @@ const std::vector<MetricInfo>& bench_metrics();
 
 // From the per-run results ({dataset, row, run, exit_code, metrics}) to
 // summary[dataset][row][metric] = {median, min, max, n}, plus ratio_to_full and ratio_to_anchor
-// (medians of ATE and of tracking ms) where those rows exist.
+// (medians of ATE and of tracking ms) where those rows exist, and ratio_to_stereo on the
+// stereo-inertial row when a stereo row exists.
 nlohmann::json summarize_runs(const nlohmann::json& results, const std::vector<BenchDataset>& datasets,
                               const std::vector<BenchRow>& rows);
 

@@ -21,6 +21,9 @@ std::vector<SlamConfiguration> builtin_slam_configurations() {
       {"no-pid", "keyframe rule without the PID offset", "keyframe: {pid: false}\n"},
       {"no-kalman", "keyframe rule without the Kalman velocity trigger", "keyframe: {kalman: false}\n"},
       {"no-loop-closing", "local mapping only (odometry)", "loop: {enabled: false}\n"},
+      {"stereo-inertial", "the IMU used where the input has one (mav0/imu0); without one, as stereo",
+       "imu: {enabled: true}\n"},
+      {"stereo", "the IMU left out (as --no-imu)", "imu: {enabled: false}\n"},
   };
 }
 

@@ -14,7 +14,7 @@ struct SlamConfiguration {
   std::string yaml;  // overrides of the preset ("" for none)
 };
 
-// full, no-lines, quadtree, no-pid, no-kalman, no-loop-closing.
+// full, no-lines, quadtree, no-pid, no-kalman, no-loop-closing, stereo-inertial, stereo.
 std::vector<SlamConfiguration> builtin_slam_configurations();
 
 // A YAML file of user configurations:
