@@ -38,8 +38,8 @@ done
 # tracking + local mapping thread + prefetch), and the robustness suites that run a threaded command (the image prefetch of
 # `plslam run`, synth and bench stopped by a signal), the keyframe database (local mapping adds,
 # tracking queries), a default run that relocalizes (RelocalizationConcurrent), and loop closing
-# (LoopClosingConcurrent: its thread and global BA on a map, and two default runs of `plslam run`
-# with all threads, compared byte for byte), the
+# (LoopClosingConcurrent: its thread and global BA on a map, and a default run of `plslam run`
+# with all threads; two such runs are compared byte for byte in Release), the
 # browser viewer's server threads and its publisher beside a run (ViewerServer, LiveViewerRun); the suites on reading user input (InputRobustness,
 # JsonStdoutRobustness, ConfigRobustness) test parsing and checks, not threads, and run in the
 # other two stages. The sequential end-to-end accuracy runs
