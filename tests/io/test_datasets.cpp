@@ -119,6 +119,32 @@ TEST(FrameStream, CorruptImageMidSequenceIsSkippedNotFatal) {
   EXPECT_EQ(stream.skipped(), 1u);
 }
 
+// A blank frame is skipped like a corrupt one, or, asked for (plslam run with the IMU), passed on
+// with its problem; a corrupt one is skipped either way.
+TEST(FrameStream, BlankFramesArePassedOnOnlyWhenAsked) {
+  TempDir tmp;
+  const auto seq = test::make_kitti(tmp.path(), 5);
+  const auto blank = seq / "image_1" / "000001.png";
+  const cv::Mat like = cv::imread((seq / "image_1" / "000000.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_TRUE(cv::imwrite(blank.string(), cv::Mat::zeros(like.size(), like.type())));
+  test::write_file(seq / "image_0" / "000003.png", "\x89PNG\r\n\x1a\n garbage");
+  const auto ds = open_dataset(seq);
+  for (const bool deliver : {false, true}) {
+    FrameStream stream(*ds, 4, deliver);
+    std::vector<std::size_t> seen;
+    while (auto f = stream.next()) {
+      seen.push_back(f->index);
+      EXPECT_EQ(f->blank, f->index == 1);
+      EXPECT_EQ(f->problem.empty(), f->index != 1);
+      if (f->blank) {
+        EXPECT_NE(f->problem.find("000001.png"), std::string::npos) << f->problem;
+      }
+    }
+    EXPECT_EQ(seen, deliver ? (std::vector<std::size_t>{0, 1, 2, 4}) : (std::vector<std::size_t>{0, 2, 4}));
+    EXPECT_EQ(stream.skipped(), deliver ? 1u : 2u);
+  }
+}
+
 TEST(FrameStream, StopsCleanlyWhenDestroyedEarly) {
   TempDir tmp;
   const auto seq = test::make_kitti(tmp.path(), 10);

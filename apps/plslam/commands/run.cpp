@@ -232,7 +232,8 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
   // With an IMU: visual-inertial initialisation, then a gravity-aligned world, tracking with the
   // IMU and its factors in local BA (stereo-inertial). --no-imu: stereo only.
   const ImuData* imu = ds && ds->imu() ? &*ds->imu() : input.camera_imu ? &*input.camera_imu : nullptr;
-  if (imu && !args.no_imu && options.use_input_imu) slam.set_imu(*imu);
+  const bool imu_used = imu && !args.no_imu && options.use_input_imu;
+  if (imu_used) slam.set_imu(*imu);
   app::install_stop_signals();
   std::string fatal;
   const auto start = std::chrono::steady_clock::now();
@@ -285,7 +286,9 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     }
   };
   std::optional<io::FrameStream> stream;
-  if (ds) stream.emplace(*ds);
+  // With the IMU, blank frames (a black-out, a covered lens) come out of the stream: the IMU carries
+  // the camera through those it can (frames.csv state inertial), the others are skipped here.
+  if (ds) stream.emplace(*ds, 4, imu_used);
   try {
     while (ds && !app::stop_requested()) {
       auto frame = stream->next();
@@ -293,6 +296,11 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
         reached = report.input_frames = stream->input_frames();  // fewer when a video ended early
         report.complete = true;
         break;
+      }
+      if (frame->blank && !slam.tracker().can_carry_by_imu(frame->timestamp)) {
+        spdlog::warn("skipping frame {}: {}", frame->index, frame->problem);
+        report.skipped.push_back({frame->index, frame->timestamp, frame->problem});
+        continue;
       }
       if (args.realtime) {
         // Pace the input at the dataset's rate, as a live camera would deliver it. A frame that
@@ -359,6 +367,7 @@ int run_slam(const RunArgs& args, const fs::path& out_dir, nlohmann::json& stats
     // Frames skipped before the stopping point belong to this run; the reader may have run ahead.
     if (s.index < reached) report.skipped.push_back(std::move(s));
   }
+  std::sort(report.skipped.begin(), report.skipped.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
   if (app::stop_requested()) {
     spdlog::warn("{}: stopping; writing the outputs of the {} frames processed", app::stop_signal_name(), report.frames);
   }

@@ -37,8 +37,10 @@ struct StereoFrame {
   cv::Mat left, right;    // 8-bit grey, rectified
   std::filesystem::path left_path, right_path;
   // Why the frame cannot be used although it decoded (a blank image), empty when it can; the
-  // frame stream skips such frames like unreadable ones.
+  // frame stream skips such frames like unreadable ones, or passes the blank ones on when asked
+  // (FrameStream's deliver_blank: the IMU may carry the camera through them).
   std::string problem;
+  bool blank = false;  // the problem is a blank image (every pixel one value)
 };
 
 struct DatasetOptions {

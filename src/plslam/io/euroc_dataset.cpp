@@ -110,6 +110,7 @@ class EurocDataset final : public Dataset {
     const cv::Mat raw_right = load_grey_image(f.right_path);
     f.problem = blank_image_problem(raw_left, f.left_path);
     if (f.problem.empty()) f.problem = blank_image_problem(raw_right, f.right_path);
+    f.blank = !f.problem.empty();
     for (const auto& [img, path] : {std::pair{&raw_left, &f.left_path}, std::pair{&raw_right, &f.right_path}}) {
       if (img->cols != cam0_.width || img->rows != cam0_.height) {
         throw InputError(path->string(), fmt::format("image is {}x{} but sensor.yaml says {}x{}", img->cols,

@@ -7,9 +7,10 @@
 
 namespace plslam::io {
 
-FrameStream::FrameStream(const Dataset& dataset, std::size_t capacity)
+FrameStream::FrameStream(const Dataset& dataset, std::size_t capacity, bool deliver_blank)
     : dataset_(dataset),
       capacity_(capacity == 0 ? 1 : capacity),
+      deliver_blank_(deliver_blank),
       input_frames_(dataset.size()),
       worker_([this] {
         core::name_this_thread("plslam-loader");
@@ -37,7 +38,7 @@ void FrameStream::run() {
       std::string reason;
       try {
         frame = dataset_.load(i);
-        if (!frame->problem.empty()) {
+        if (!frame->problem.empty() && !(deliver_blank_ && frame->blank)) {
           reason = frame->problem;
           frame.reset();
           spdlog::warn("skipping frame {}: {}", i, reason);

@@ -26,7 +26,10 @@ struct SkippedFrame {
 
 class FrameStream {
  public:
-  explicit FrameStream(const Dataset& dataset, std::size_t capacity = 4);
+  // deliver_blank: a frame whose images are blank (StereoFrame::blank) comes out of next() with its
+  // problem set instead of being skipped; its taker decides (plslam run: the IMU carries it, or
+  // it is skipped there).
+  explicit FrameStream(const Dataset& dataset, std::size_t capacity = 4, bool deliver_blank = false);
   ~FrameStream();
   FrameStream(const FrameStream&) = delete;
   FrameStream& operator=(const FrameStream&) = delete;
@@ -51,6 +54,7 @@ class FrameStream {
 
   const Dataset& dataset_;
   const std::size_t capacity_;
+  const bool deliver_blank_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
   std::deque<StereoFrame> queue_;

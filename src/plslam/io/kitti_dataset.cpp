@@ -170,6 +170,7 @@ class KittiDataset final : public Dataset {
     f.right = load_grey_image(f.right_path);
     f.problem = blank_image_problem(f.left, f.left_path);
     if (f.problem.empty()) f.problem = blank_image_problem(f.right, f.right_path);
+    f.blank = !f.problem.empty();
     if (f.left.size() != f.right.size()) {
       throw InputError(f.right_path.string(), fmt::format("right image is {}x{} but left is {}x{}",
                                                           f.right.cols, f.right.rows, f.left.cols, f.left.rows));

@@ -197,7 +197,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     if (last_ && !records_.empty() && records_.back().reference) last_->T_cw = pose_of(records_.back());
   }
   prior_.reset();
-  if (state_ == TrackingState::kOk) prior_ = imu_prior(f);
+  if (state_ == TrackingState::kOk) prior_ = imu_prior(f.data->timestamp);
   bool inertial = false;
 
   bool ok = false;

@@ -84,8 +84,10 @@ struct ImuTrackingOptions {
   // A keyframe is due once the last one is this old: preintegration stays short (ORB-SLAM3: 0.5 s).
   double max_keyframe_interval_s = 0.5;
   // The IMU predicts from the newest keyframe of the chain whose state a local BA estimated
-  // (map::KeyFrameImu::estimated), if it is at most this much older than the frame.
-  double max_prediction_s = 1.5;
+  // (map::KeyFrameImu::estimated), if it is at most this much older than the frame. Long enough
+  // for a black-out of max_inertial_s after a keyframe's interval (ORB-SLAM3 keeps a recently
+  // lost camera on the IMU for 5 s): a 3 s black-out then rejoins the map.
+  double max_prediction_s = 5.0;
   // Only a frame with fewer stereo points than this (a black or blurred image, a covered lens) is
   // carried by the IMU when vision fails; a textured frame vision cannot track is lost, as without
   // an IMU (its failure is no lack of texture, and the IMU cannot tell what else went wrong).
@@ -93,7 +95,7 @@ struct ImuTrackingOptions {
   // A frame that vision cannot track (a black or blurred image, a covered lens) takes the IMU's
   // prediction, state `inertial`, for at most this long after the last frame vision tracked;
   // then the camera is lost, as without an IMU.
-  double max_inertial_s = 3.0;
+  double max_inertial_s = 4.0;
 };
 
 struct TrackerOptions {
@@ -243,6 +245,10 @@ class Tracker {
   // Frames tracked with the IMU's residual, and frames the IMU carried alone (state inertial).
   int imu_tracked_frames() const { return imu_tracked_frames_; }
   int inertial_frames() const { return inertial_frames_; }
+  // Whether a frame at time t that vision cannot use (a blank image) would now take the IMU's pose
+  // (state inertial): tracking is on, with the IMU's prediction, within max_inertial_s of the last
+  // frame vision tracked. plslam run passes its blank frames to tracking only then.
+  bool can_carry_by_imu(double t) const;
   // Place recognition for relocalization; without one, a lost camera starts a new map segment on
   // the next frame that can. Not owned; must outlive the tracker.
   void set_keyframe_database(const place::KeyframeDatabase* database) { database_ = database; }
@@ -309,7 +315,7 @@ class Tracker {
     inertial::InertialState predicted;
     geometry::SE3 T_cw;  // the camera's predicted pose
   };
-  std::optional<ImuPrior> imu_prior(const Frame& f) const;
+  std::optional<ImuPrior> imu_prior(double t) const;
   // The IMU state a keyframe made from `f` starts with; `chained`: linked to the last keyframe's.
   map::KeyFrameImu keyframe_imu(const Frame& f, bool chained) const;
   // optim::optimize_pose with the IMU's residual from prior_ (f.imu gets the velocity and biases).

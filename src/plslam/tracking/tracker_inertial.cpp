@@ -62,9 +62,8 @@ void Tracker::use_imu(const ImuData& imu, const inertial::ImuBias& bias) {
   spdlog::info("imu: tracking with the IMU from here on; its chain starts with {} keyframes", chain.size());
 }
 
-std::optional<Tracker::ImuPrior> Tracker::imu_prior(const Frame& f) const {
+std::optional<Tracker::ImuPrior> Tracker::imu_prior(double t) const {
   if (!imu_ || !imu_chain_live_ || recovery_ || !last_keyframe_ || last_keyframe_->is_bad()) return std::nullopt;
-  const double t = f.data->timestamp;
   // The newest keyframe of the chain that a local BA estimated.
   const map::KeyFrame* kf = last_keyframe_;
   std::optional<map::KeyFrameImu> state = kf->imu();
@@ -164,6 +163,11 @@ bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
   t.track_motion_ms += ms_since(t0);
   spdlog::debug("frame {}: {} matches in {} keyframes near the IMU's prediction, {} inliers", f.id(), found, n, inliers);
   return inliers >= options_.min_pose_inliers;
+}
+
+bool Tracker::can_carry_by_imu(double t) const {
+  return state_ == TrackingState::kOk && last_visual_t_ && t - *last_visual_t_ <= options_.imu.max_inertial_s &&
+         imu_prior(t).has_value();
 }
 
 bool Tracker::carry_by_imu(Frame& f) {
