@@ -51,7 +51,7 @@ for motion in $motions; do
     if [ "$blackout" -ge 0 ]; then
       input="$seq.blackout$blackout"
       rm -rf "$input"
-      cp -rs "$seq" "$input"
+      cp -rsH "$seq" "$input"  # -H: a render given as a symlink is copied, not written through
       python3 bench/lib/aliasing.py blackout "$input" "$blackout" 20
     fi
     "$plslam" run "$input" --out "$out/vi_${motion}_$seed" --quiet > /dev/null 2>&1 || true
