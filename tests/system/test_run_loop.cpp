@@ -79,8 +79,9 @@ class LoopRun : public ::testing::Test {
   }
 
   // A default run whose global BA is merged 1 s of input time after the correction's end.
+  // Each run writes its own config file: the identity test starts two at once in one folder.
   static nlohmann::json run_default(const fs::path& dir, const std::string& name) {
-    const auto config = dir / "merge.yaml";
+    const auto config = dir / (name + "_merge.yaml");
     std::ofstream(config) << "loop:\n  global_ba_merge_after_s: 1.0\n";
     return run(dir / name, " --config \"" + config.string() + "\"");
   }

@@ -324,6 +324,8 @@ class Tracker {
                                                const optim::PoseOnlyOptions& options);
   // A frame vision could not track, within max_inertial_s of the last it did: the IMU's pose.
   bool carry_by_imu(Frame& f);
+  // Whether t is at most max_inertial_s after the last frame vision tracked.
+  bool within_inertial_window(double t) const;
   // After a gap the last frame's matches and the reference keyframe may be out of view: the map
   // points of the keyframes nearest the IMU's predicted pose, searched by projection from it.
   bool track_from_imu_prediction(Frame& f, TrackStageTimes& t);

@@ -165,9 +165,12 @@ bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
   return inliers >= options_.min_pose_inliers;
 }
 
+bool Tracker::within_inertial_window(double t) const {
+  return last_visual_t_ && t - *last_visual_t_ <= options_.imu.max_inertial_s;
+}
+
 bool Tracker::can_carry_by_imu(double t) const {
-  return state_ == TrackingState::kOk && last_visual_t_ && t - *last_visual_t_ <= options_.imu.max_inertial_s &&
-         imu_prior(t).has_value();
+  return state_ == TrackingState::kOk && within_inertial_window(t) && imu_prior(t).has_value();
 }
 
 bool Tracker::carry_by_imu(Frame& f) {
@@ -175,7 +178,7 @@ bool Tracker::carry_by_imu(Frame& f) {
   const Eigen::Vector3d c = prior_->T_cw.inverse().translation();
   spdlog::debug("frame {}: vision failed; the IMU predicts it from keyframe {}, {:.2f} s earlier, at ({:.3f} {:.3f} {:.3f})",
                 f.id(), prior_->keyframe->id(), prior_->pim->dt(), c.x(), c.y(), c.z());
-  if (!last_visual_t_ || f.data->timestamp - *last_visual_t_ > options_.imu.max_inertial_s) return false;
+  if (!within_inertial_window(f.data->timestamp)) return false;
   if (f.num_stereo_points() >= options_.imu.max_texture_points) return false;
   f.clear_matches();
   f.T_cw = prior_->T_cw;
