@@ -27,7 +27,10 @@ GlobalBaSnapshot snapshot_for_global_ba(const map::Map& map, const GlobalBaOptio
     s.problem->add_keyframe(kf, has_origin ? kf->is_origin() : kf == keyframes.front());
   }
   s.problem->add_landmarks_of(keyframes);
-  if (o.T_imu_cam) s.problem->add_imu_factors(keyframes, *o.T_imu_cam, o.reintegration, /*add_missing=*/false);
+  if (o.T_imu_cam) {
+    s.problem->add_imu_factors(keyframes, *o.T_imu_cam, o.reintegration, /*add_missing=*/false);
+    s.problem->hold_imu_gauge_by_centre_and_heading();
+  }
   return s;
 }
 

@@ -26,8 +26,9 @@ struct GlobalBaOptions {
   double far_stereo_baselines = 0;
   bool lines = true;
   // A visual-inertial map (LoopCloser::use_imu): the IMU factors between consecutive keyframes of
-  // the IMU chain join the BA, with every keyframe's velocity and biases (the map's origin holds
-  // the gauge as before).
+  // the IMU chain join the BA, with every keyframe's velocity and biases. The map's origin holds
+  // the gauge as before, but where it is in the IMU chain by its centre and heading alone: gravity
+  // sets its roll and pitch (inertial/gauge_prior_factor.h).
   std::optional<geometry::SE3> T_imu_cam;
   inertial::ReintegrationThresholds reintegration;
   void validate() const;

@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "plslam/core/pointer_set.h"
+#include "plslam/inertial/gauge_prior_factor.h"
 #include "plslam/inertial/imu_ba_factor.h"
 
 namespace plslam::mapping {
@@ -96,12 +97,27 @@ void MapBaProblem::add_imu_factors(const std::vector<map::KeyFrame*>& chain, con
   }
 }
 
-void MapBaProblem::write_back_imu_states(const optim::BaResult& result) const {
-  if (result.keyframe_extra.empty()) return;
+std::vector<bool> MapBaProblem::in_keyframe_factor() const {
   std::vector<bool> in_factor(keyframes.size(), false);
   for (const auto& f : problem.keyframe_factors) {
     for (const int k : f->keyframes()) in_factor[static_cast<std::size_t>(k)] = true;
   }
+  return in_factor;
+}
+
+void MapBaProblem::hold_imu_gauge_by_centre_and_heading() {
+  const std::vector<bool> in_factor = in_keyframe_factor();
+  for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    if (!problem.keyframes[k].fixed || !in_factor[k]) continue;
+    problem.keyframes[k].fixed = false;
+    problem.keyframe_factors.push_back(
+        std::make_shared<inertial::GaugePriorFactor>(static_cast<int>(k), problem.keyframes[k].T_cw));
+  }
+}
+
+void MapBaProblem::write_back_imu_states(const optim::BaResult& result) const {
+  if (result.keyframe_extra.empty()) return;
+  const std::vector<bool> in_factor = in_keyframe_factor();
   for (std::size_t k = 0; k < keyframes.size(); ++k) {
     if (!in_factor[k] || problem.keyframes[k].fixed || keyframes[k]->is_bad() || !keyframes[k]->has_imu()) continue;
     keyframes[k]->set_imu_velocity_and_bias(inertial::velocity_of(result.keyframe_extra[k]),

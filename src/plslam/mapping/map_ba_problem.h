@@ -30,6 +30,10 @@ class MapBaProblem {
   // integrated again at it. Call after every keyframe is added.
   void add_imu_factors(const std::vector<map::KeyFrame*>& chain, const geometry::SE3& T_imu_cam,
                        const inertial::ReintegrationThresholds& reintegration, bool add_missing);
+  // A whole map's BA: a fixed keyframe that holds the gauge and has IMU factors is held by its
+  // camera centre and heading alone (inertial/gauge_prior_factor.h); gravity sets its roll and
+  // pitch, and its velocity and biases are estimated. Call after add_imu_factors.
+  void hold_imu_gauge_by_centre_and_heading();
   // Writes a result's velocities and biases into the free keyframes that have IMU factors (their
   // states become `estimated`).
   void write_back_imu_states(const optim::BaResult& result) const;
@@ -48,6 +52,7 @@ class MapBaProblem {
   bool with_lines_;
   std::unordered_map<const map::KeyFrame*, int> index_;
   void fill_keyframe_extra();
+  std::vector<bool> in_keyframe_factor() const;  // per keyframe: in some keyframe factor
 };
 
 }  // namespace plslam::mapping

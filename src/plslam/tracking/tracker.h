@@ -79,8 +79,11 @@ struct RelocalizationOptions {
 // Tracking with the IMU, once the map is gravity-aligned (Tracker::use_imu).
 struct ImuTrackingOptions {
   // Keyframes of the IMU chain started at use_imu(): the last ones, their velocities estimated from
-  // their positions until local BA settles them (LocalMapperOptions::imu_window).
-  int seed_keyframes = 10;
+  // their positions until local BA (LocalMapperOptions::imu_window) or a global BA settles them.
+  // 0: every keyframe of the current segment, as ORB-SLAM3 makes every keyframe of the map
+  // inertial at its initialisation: a global BA after a loop then has the IMU's factors from the
+  // first keyframe on, where the camera was tracked without them.
+  int seed_keyframes = 0;
   // A keyframe is due once the last one is this old: preintegration stays short (ORB-SLAM3: 0.5 s).
   double max_keyframe_interval_s = 0.5;
   // The IMU predicts from the newest keyframe of the chain whose state a local BA estimated
@@ -236,7 +239,7 @@ class Tracker {
 
   TrackResult track(std::shared_ptr<const map::FrameData> data);
   // The map is gravity-aligned (z up, the IMU initialised with `bias`): the last
-  // options.imu.seed_keyframes keyframes start the IMU chain (map::KeyFrameImu), and from the
+  // options.imu.seed_keyframes keyframes (0: all) start the IMU chain (map::KeyFrameImu), and from the
   // next frame on, once local BA has estimated the last keyframe's velocity, the IMU predicts each
   // frame from it and the pose optimisation adds the IMU's residual (inertial/inertial_pose.h).
   // `imu` is not owned and must outlive the tracker.

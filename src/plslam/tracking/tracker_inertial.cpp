@@ -41,8 +41,8 @@ void Tracker::use_imu(const ImuData& imu, const inertial::ImuBias& bias) {
       chain.push_back(kf);
     }
   }
-  const auto n = static_cast<std::size_t>(std::max(1, options_.imu.seed_keyframes));
-  if (chain.size() > n) chain.erase(chain.begin(), chain.end() - static_cast<std::ptrdiff_t>(n));
+  const auto n = static_cast<std::size_t>(std::max(0, options_.imu.seed_keyframes));
+  if (n > 0 && chain.size() > n) chain.erase(chain.begin(), chain.end() - static_cast<std::ptrdiff_t>(n));
   const geometry::SE3 T_cam_imu = T_imu_cam_.inverse();
   std::vector<Eigen::Vector3d> p;
   for (const auto* kf : chain) p.push_back((kf->pose_inverse() * T_cam_imu).translation());
