@@ -95,6 +95,7 @@ plslam_suite(BlackOut COST 80 LABELS sanitizer_skip)
 # A 110-frame render and run (5 s in Release): the initialisation's code runs under the sanitizers in
 # RunImuInit.EurocMicro* (the same path through plslam run) and ViInitializer.*.
 plslam_test(RunImuInit.RenderedHandheldWalkIsInitialisedNearTheTruth COST 5 LABELS sanitizer_skip)
+plslam_test(RunImuInit.RenderedCarIsInitialisedNearTheTruthOrNotAtAll COST 3 LABELS sanitizer_skip)
 # A 240-frame render and two runs (8 s in Release): the stream's blank frames run under the
 # sanitizers in FrameStream.BlankFramesArePassedOnOnlyWhenAsked, the stereo-inertial tracking in
 # the office loop of LoopClosingConcurrent (its render has an IMU).

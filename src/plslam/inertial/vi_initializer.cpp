@@ -26,7 +26,7 @@ void ViInitOptions::validate() const {
   if (!(max_rms_residual > 0)) throw std::invalid_argument("ViInitOptions: max_rms_residual must be > 0");
   if (!(gyro_bias_prior > 0) || !(acc_bias_prior > 0)) throw std::invalid_argument("ViInitOptions: bias priors must be > 0");
   if (max_relinearisations < 0) throw std::invalid_argument("ViInitOptions: max_relinearisations must be >= 0");
-  if (!(pose_position_sigma >= 0) || !(pose_rotation_sigma >= 0)) {
+  if (!(pose_position_sigma >= 0) || !(pose_rotation_sigma >= 0) || !(pose_position_sigma_per_m >= 0)) {
     throw std::invalid_argument("ViInitOptions: pose sigmas must be >= 0");
   }
 }
@@ -193,10 +193,13 @@ ViInitResult initialize_visual_inertial(std::span<const ViKeyframe> keyframes, c
       problem->AddResidualBlock(new ceres::AutoDiffCostFunction<FixedRotationImuResidual, 9, 3, 3, 3, 3, 3, 6>(f), nullptr,
                                 g.data(), v[k].data(), v[k + 1].data(), p[k].data(), p[k + 1].data(), b.data());
     }
+    double path = 0;  // travelled since the window's first keyframe
     for (std::size_t k = 0; k < n; ++k) {
+      if (k > 0) path += (p_measured[k] - p_measured[k - 1]).norm();
       if (options.pose_position_sigma > 0) {
+        const double sigma = std::hypot(options.pose_position_sigma, options.pose_position_sigma_per_m * path);
         problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PositionPrior, 3, 3>(
-                                      new PositionPrior{p_measured[k], 1 / options.pose_position_sigma}),
+                                      new PositionPrior{p_measured[k], 1 / sigma}),
                                   nullptr, p[k].data());
       } else {
         problem->SetParameterBlockConstant(p[k].data());
