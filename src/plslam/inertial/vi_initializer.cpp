@@ -155,6 +155,13 @@ ViInitResult initialize_visual_inertial(std::span<const ViKeyframe> keyframes, c
     p[k] = T_wb.translation();
   }
   const std::vector<Eigen::Vector3d> p_measured = p;  // the priors' centres; p moves
+  // The position priors' widths: they grow with the path travelled since the window's first keyframe.
+  std::vector<double> position_sigma(n);
+  double path = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k > 0) path += (p_measured[k] - p_measured[k - 1]).norm();
+    position_sigma[k] = std::hypot(options.pose_position_sigma, options.pose_position_sigma_per_m * path);
+  }
   std::vector<Preintegration> pre;
   ImuBias bias;
   try {
@@ -193,13 +200,10 @@ ViInitResult initialize_visual_inertial(std::span<const ViKeyframe> keyframes, c
       problem->AddResidualBlock(new ceres::AutoDiffCostFunction<FixedRotationImuResidual, 9, 3, 3, 3, 3, 3, 6>(f), nullptr,
                                 g.data(), v[k].data(), v[k + 1].data(), p[k].data(), p[k + 1].data(), b.data());
     }
-    double path = 0;  // travelled since the window's first keyframe
     for (std::size_t k = 0; k < n; ++k) {
-      if (k > 0) path += (p_measured[k] - p_measured[k - 1]).norm();
       if (options.pose_position_sigma > 0) {
-        const double sigma = std::hypot(options.pose_position_sigma, options.pose_position_sigma_per_m * path);
         problem->AddResidualBlock(new ceres::AutoDiffCostFunction<PositionPrior, 3, 3>(
-                                      new PositionPrior{p_measured[k], 1 / sigma}),
+                                      new PositionPrior{p_measured[k], 1 / position_sigma[k]}),
                                   nullptr, p[k].data());
       } else {
         problem->SetParameterBlockConstant(p[k].data());
