@@ -1,14 +1,13 @@
 // The visual-inertial initialisation during `plslam run`: on the real EuRoC micro excerpt (the
 // drone stands nearly still) gravity is refused as unobservable and the gyro bias is estimated,
 // against EuRoC's ground-truth bias; a rendered car is initialised near the truth; a rendered
-// handheld walk with EuRoC's noise and biases is
-// initialised with gravity and the gyro bias near the truth, and its map file, with the IMU
-// states, is loaded with the IMU (stereo-inertial in the map's world) and without.
+// handheld walk with EuRoC's noise and biases is initialised with gravity and the gyro bias near
+// the truth, and its map file, with the IMU states, is loaded with the IMU (stereo-inertial in the
+// map's world) and without.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -52,14 +51,9 @@ Eigen::Vector3d vec(const nlohmann::json& j) { return {j[0].get<double>(), j[1].
 // The initialisation's gravity against a render's: the run's world is the first camera's, where
 // gravity comes from the rendered ground truth (z up).
 double gravity_error_deg(const fs::path& seq, const nlohmann::json& init) {
-  std::ifstream gt(seq / "mav0" / "synth" / "left_camera.tum");
-  std::string line;
-  do std::getline(gt, line);
-  while (line.empty() || line[0] == '#');
-  std::stringstream ss(line);
-  double t, x, y, z, qx, qy, qz, qw;
-  ss >> t >> x >> y >> z >> qx >> qy >> qz >> qw;
-  const Eigen::Vector3d g_true = Eigen::Quaterniond(qw, qx, qy, qz).toRotationMatrix().transpose() * Eigen::Vector3d(0, 0, -1);
+  const std::vector<double> first = io::read_numeric_rows(seq / "mav0" / "synth" / "left_camera.tum").front().values;
+  const Eigen::Quaterniond q(first[7], first[4], first[5], first[6]);
+  const Eigen::Vector3d g_true = q.toRotationMatrix().transpose() * Eigen::Vector3d(0, 0, -1);
   const Eigen::Vector3d g = vec(init["gravity_direction_world"]);
   return std::atan2(g.cross(g_true).norm(), g.dot(g_true)) * 180 / M_PI;
 }
