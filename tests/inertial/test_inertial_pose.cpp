@@ -4,6 +4,9 @@
 // truth: with rich vision, with vision that leaves a rotation open (the IMU closes it), and with
 // gross outliers among the matches.
 #include <cmath>
+#include <memory>
+#include <span>
+#include <stdexcept>
 
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
@@ -93,6 +96,43 @@ TEST(InertialPrediction, ReachesTheTrueStateAndItsResidualIsZero) {
   const InertialTerms terms(f.pim, i.state, f.T_imu_cam);
   const SE3 T_cw = (p.T_wb * f.T_imu_cam).inverse();
   EXPECT_LT(terms.evaluate(T_cw, p.v, p.bias).head<9>().norm(), 1e-9);
+}
+
+// Keyframes 0.1-0.2 s apart through the hand-held-like motion's swings: the seeds from poses and
+// IMU are exact where the positions' differences miss by the acceleration times the interval.
+TEST(SeedVelocities, ExactFromPosesAndImuWherePositionDifferencesAreOff) {
+  const test::SinusoidMotion motion;
+  const ImuBias bias{Eigen::Vector3d(0.004, -0.003, 0.002), Eigen::Vector3d(0.05, -0.08, 0.03)};
+  const std::vector<double> t = {0.30, 0.45, 0.55, 0.75, 0.85, 1.00, 1.20};
+  const auto samples = test::sample_motion(motion, 0.2, 1.3, 0.001, bias);
+  std::vector<SE3> T_wb;
+  std::vector<std::unique_ptr<Preintegration>> owned;
+  std::vector<const Preintegration*> intervals;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const test::BodyState s = motion.at(t[k]);
+    T_wb.emplace_back(s.R, s.p);
+    if (k > 0) owned.push_back(std::make_unique<Preintegration>(samples, t[k - 1], t[k], bias, kEurocAdis16448Noise));
+    intervals.push_back(k > 0 ? owned.back().get() : nullptr);
+  }
+  const auto v = seed_velocities(T_wb, intervals, bias);
+  ASSERT_EQ(v.size(), t.size());
+  double worst_difference = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    EXPECT_LT((v[k] - motion.at(t[k]).v).norm(), 2e-3) << "keyframe " << k;
+    const std::size_t a = k == 0 ? 0 : k - 1, b = std::min(k + 1, t.size() - 1);
+    const Eigen::Vector3d difference = (T_wb[b].translation() - T_wb[a].translation()) / (t[b] - t[a]);
+    worst_difference = std::max(worst_difference, (difference - motion.at(t[k]).v).norm());
+  }
+  EXPECT_GT(worst_difference, 0.1);  // what the seeds were before: the test tells them apart
+  // Gaps in the samples: the pose before one is seeded from the interval before it, and a pose
+  // the IMU joins to neither neighbour keeps zero.
+  intervals[3] = nullptr;
+  intervals[5] = intervals[6] = nullptr;
+  const auto w = seed_velocities(T_wb, intervals, bias);
+  for (const std::size_t k : {1, 2, 3, 4}) EXPECT_LT((w[k] - motion.at(t[k]).v).norm(), 2e-3) << "keyframe " << k;
+  EXPECT_EQ(w[5], Eigen::Vector3d::Zero());
+  EXPECT_EQ(w[6], Eigen::Vector3d::Zero());
+  EXPECT_THROW(seed_velocities(T_wb, std::span(intervals).first(2), bias), std::invalid_argument);
 }
 
 TEST(InertialTerms, SmallAtTheTruth) {

@@ -1,5 +1,7 @@
 #include "plslam/inertial/inertial_pose.h"
 
+#include <stdexcept>
+
 #include "plslam/inertial/imu_pose_manifold.h"
 #include "plslam/optim/pose_rounds.h"
 #include "plslam/optim/pose_terms.h"
@@ -21,6 +23,21 @@ InertialState predict(const InertialState& i, const Preintegration& i_to_j) {
   j.v = i.v + g * dt + R_i * i_to_j.corrected_delta_v(i.bias);
   j.bias = i.bias;
   return j;
+}
+
+std::vector<Eigen::Vector3d> seed_velocities(std::span<const SE3> T_wb, std::span<const Preintegration* const> from_previous,
+                                             const ImuBias& bias) {
+  if (from_previous.size() != T_wb.size()) throw std::invalid_argument("seed_velocities: one interval per pose");
+  std::vector<Eigen::Vector3d> v(T_wb.size(), Eigen::Vector3d::Zero());
+  for (std::size_t k = 0; k < T_wb.size(); ++k) {
+    if (const Preintegration* next = k + 1 < T_wb.size() ? from_previous[k + 1] : nullptr) {
+      const Eigen::Vector3d at_rest = predict({T_wb[k], Eigen::Vector3d::Zero(), bias}, *next).T_wb.translation();
+      v[k] = (T_wb[k + 1].translation() - at_rest) / next->dt();
+    } else if (const Preintegration* previous = from_previous[k]) {
+      v[k] = predict({T_wb[k - 1], v[k - 1], bias}, *previous).v;  // v[k - 1] came from this interval
+    }
+  }
+  return v;
 }
 
 InertialTerms::InertialTerms(const Preintegration& i_to_frame, const InertialState& i, const SE3& T_imu_cam)

@@ -12,6 +12,7 @@
 // The pose is that of the left camera, perturbed as in optim/pose_only.h (T_cw <- exp(delta) T_cw,
 // delta = (translation, rotation)); the body (IMU) pose follows as T_wb = T_cw^-1 T_imu_cam^-1, so
 // a camera perturbation moves the body by T_wb <- T_wb exp(-Ad(T_imu_cam) delta).
+#include <span>
 #include <vector>
 
 #include <Eigen/Core>
@@ -40,6 +41,16 @@ struct InertialState {
 // the deltas corrected for i's bias, which it keeps: R_j = R_i dR, v_j = v_i + g dt + R_i dv,
 // p_j = p_i + v_i dt + g dt^2 / 2 + R_i dp. Tracking's prediction of the next frame.
 InertialState predict(const InertialState& i, const Preintegration& i_to_j);
+
+// Velocity seeds for body poses in time order that the IMU connects, `from_previous[k]` from pose
+// k-1 to pose k (null for k = 0 or where no samples join them): from each pose and its successor,
+// v_i = (p_j - p_i - g dt^2 / 2 - R_i delta_p) / dt (delta_p at `bias`); a pose with no successor
+// (the last, or one before a gap) takes the velocity predict() gives at the end of the interval
+// before it. Exact for exact poses and IMU, where differences of positions alone miss by the
+// acceleration times the interval. A pose the IMU joins to neither neighbour keeps zero.
+std::vector<Eigen::Vector3d> seed_velocities(std::span<const geometry::SE3> T_wb,
+                                             std::span<const Preintegration* const> from_previous,
+                                             const ImuBias& bias);
 
 // The IMU terms between a fixed state i and a frame: 9 whitened IMU residual rows and 6 whitened
 // bias walk rows, with their Jacobian over the frame's tangent [delta (6, of T_cw); dv (3); dbias
