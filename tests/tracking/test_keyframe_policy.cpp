@@ -1,6 +1,8 @@
+#include <algorithm>
 #include <cmath>
 #include <random>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "plslam/core/error.h"
@@ -156,6 +158,38 @@ TEST(KeyframePolicy, KalmanForcesKeyframeAboveSevenMetresPerSecond) {
       // At most every velocity_min_frames (2) frames, and from the first frames on.
       EXPECT_GE(inserted_by_velocity, 18) << speed;
       EXPECT_LE(inserted_by_velocity, 20) << speed;
+    }
+  }
+}
+
+// A camera walking at 1.4 m/s, 5 m from the world's origin, when the world is turned by 90 deg to
+// gravity (System::align_world_with_gravity): the positions jump by 7 m between two frames, which
+// the policy must not read as a speed.
+TEST(KeyframePolicy, TheWorldTurningUnderTheMapIsNoSpeed) {
+  for (const bool told : {true, false}) {
+    KeyframePolicyOptions o;
+    o.pid = false;
+    KeyframePolicy policy(o);
+    const geometry::SE3 T_new_old(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix(),
+                                  Eigen::Vector3d::Zero());
+    KeyframeInputs first = frame(1, 0.05, 5.0, 390, 400);
+    policy.decide(first);
+    policy.keyframe_inserted(first);
+    double max_speed = 0;
+    int velocity_keyframes = 0;
+    for (int k = 2; k <= 40; ++k) {
+      KeyframeInputs in = frame(k, 0.05 * k, 5.0 + 1.4 * 0.05 * (k - 1), 390, 400);
+      if (k == 20 && told) policy.transform_world(T_new_old);
+      if (k >= 20) in.position = T_new_old * in.position;
+      const auto d = policy.decide(in);
+      if (k > 10) max_speed = std::max(max_speed, d.speed);
+      if (d.insert && d.reason == KeyframeReason::kVelocity) ++velocity_keyframes;
+    }
+    if (told) {
+      EXPECT_NEAR(max_speed, 1.4, 0.1);
+      EXPECT_EQ(velocity_keyframes, 0);
+    } else {
+      EXPECT_GT(max_speed, 7.0);  // what the turn looked like before
     }
   }
 }

@@ -93,6 +93,11 @@ KeyframeDecision KeyframePolicy::decide(const KeyframeInputs& in) {
   return d;
 }
 
+void KeyframePolicy::transform_world(const geometry::SE3& T_new_old) {
+  if (reference_position_) reference_position_ = T_new_old * *reference_position_;
+  kalman_.rotate(T_new_old.rotation());
+}
+
 void KeyframePolicy::keyframe_inserted(const KeyframeInputs& in) {
   last_keyframe_id_ = in.frame_id;
   pid_.reset();

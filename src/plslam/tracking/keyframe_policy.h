@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "plslam/geometry/se3.h"
 #include "plslam/tracking/pid_controller.h"
 #include "plslam/tracking/velocity_kalman_filter.h"
 
@@ -87,6 +88,11 @@ class KeyframePolicy {
   KeyframeDecision decide(const KeyframeInputs& in);
   // Call when a keyframe was actually created from the frame passed to the last decide().
   void keyframe_inserted(const KeyframeInputs& in);
+  // The world moved under the map (Map::transform_world, p_new = T_new_old p_old): the positions
+  // decide() is given from now on are in the new world, and the reference keyframe's and the
+  // speed estimate move with them (else the jump reads as a speed: 142 m/s when a handheld run's
+  // world turned to gravity 5 m from its origin, and a keyframe for it).
+  void transform_world(const geometry::SE3& T_new_old);
 
   const KeyframePolicyOptions& options() const { return options_; }
 

@@ -131,6 +131,7 @@ void Tracker::transform_world(const geometry::SE3& T_new_old) {
   for (FrameRecord& r : records_) {
     if (!r.reference) r.T_cr = r.T_cr * T_old_new;
   }
+  policy_.transform_world(T_new_old);
 }
 
 bool Tracker::check_motion(const Frame& f) {

@@ -16,6 +16,14 @@ void VelocityKalmanFilter::reset_reference() {
   P_.leftCols<3>().setZero();
 }
 
+void VelocityKalmanFilter::rotate(const Eigen::Matrix3d& R_new_old) {
+  Eigen::Matrix<double, 6, 6> R = Eigen::Matrix<double, 6, 6>::Zero();
+  R.topLeftCorner<3, 3>() = R_new_old;
+  R.bottomRightCorner<3, 3>() = R_new_old;
+  x_ = (R * x_).eval();
+  P_ = (R * P_ * R.transpose()).eval();
+}
+
 void VelocityKalmanFilter::update(double dt, const Eigen::Vector3d& displacement) {
   if (dt > 0) {
     // x' = F x with F = [I dt·I; 0 I]; Q from white acceleration: [dt^3/3 dt^2/2; dt^2/2 dt]·q.

@@ -22,6 +22,9 @@ class VelocityKalmanFilter {
   // Starts measuring from a new reference keyframe: the displacement restarts at zero (exactly
   // known), the velocity estimate and its uncertainty carry over.
   void reset_reference();
+  // The world's axes turned by R_new_old: the displacement, the velocity and their covariance
+  // turn with them.
+  void rotate(const Eigen::Matrix3d& R_new_old);
   // Predicts over dt seconds and fuses the measured displacement from the reference keyframe.
   void update(double dt, const Eigen::Vector3d& displacement);
 
