@@ -133,6 +133,11 @@ TEST(SeedVelocities, ExactFromPosesAndImuWherePositionDifferencesAreOff) {
   EXPECT_EQ(w[5], Eigen::Vector3d::Zero());
   EXPECT_EQ(w[6], Eigen::Vector3d::Zero());
   EXPECT_THROW(seed_velocities(T_wb, std::span(intervals).first(2), bias), std::invalid_argument);
+  // An interval given for the first pose joins it to nothing before it: ignored, so the first
+  // pose, without its successor's interval either, keeps zero.
+  intervals[0] = intervals[1];
+  intervals[1] = nullptr;
+  EXPECT_EQ(seed_velocities(T_wb, intervals, bias)[0], Eigen::Vector3d::Zero());
 }
 
 TEST(InertialTerms, SmallAtTheTruth) {

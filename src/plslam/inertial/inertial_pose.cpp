@@ -33,7 +33,7 @@ std::vector<Eigen::Vector3d> seed_velocities(std::span<const SE3> T_wb, std::spa
     if (const Preintegration* next = k + 1 < T_wb.size() ? from_previous[k + 1] : nullptr) {
       const Eigen::Vector3d at_rest = predict({T_wb[k], Eigen::Vector3d::Zero(), bias}, *next).T_wb.translation();
       v[k] = (T_wb[k + 1].translation() - at_rest) / next->dt();
-    } else if (const Preintegration* previous = from_previous[k]) {
+    } else if (const Preintegration* previous = k > 0 ? from_previous[k] : nullptr) {
       v[k] = predict({T_wb[k - 1], v[k - 1], bias}, *previous).v;  // v[k - 1] came from this interval
     }
   }

@@ -63,6 +63,11 @@ void Tracker::use_imu(const ImuData& imu, const inertial::ImuBias& bias) {
   const auto v = inertial::seed_velocities(T_wb, intervals, bias);
   for (std::size_t k = 0; k < chain.size(); ++k) {
     states[k].v = v[k];
+    // No IMU samples on either side: the difference of its neighbours' positions, as before.
+    const std::size_t a = k == 0 ? 0 : k - 1, b = std::min(k + 1, chain.size() - 1);
+    if (!intervals[k] && (k + 1 == chain.size() || !intervals[k + 1]) && b > a) {
+      states[k].v = (T_wb[b].translation() - T_wb[a].translation()) / (chain[b]->timestamp() - chain[a]->timestamp());
+    }
     chain[k]->set_imu(states[k]);
   }
   imu_chain_live_ = state_ == TrackingState::kOk;
