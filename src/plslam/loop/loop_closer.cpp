@@ -119,6 +119,25 @@ void LoopCloser::global_ba_after_keyframe(long keyframe_id, long before_loss_key
   revisit_keyframe_ = keyframe_id;
 }
 
+void LoopCloser::refine_inertial_after_keyframe(long keyframe_id) {
+  if (!options_.global_ba || !options_.global_ba_options.T_imu_cam) return;
+  refine_keyframe_ = keyframe_id;
+}
+
+void LoopCloser::serve_inertial_refinement(const map::KeyFrame& kf, bool loop_closed) {
+  long at = refine_keyframe_;
+  if (at < 0 || kf.id() < at || !refine_keyframe_.compare_exchange_strong(at, -1)) return;
+  if (loop_closed) return;  // the loop's global BA refines the same
+  spdlog::info("global BA to refine the IMU's initialisation: keyframe {} (frame {})", kf.id(), kf.frame_id());
+  {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.global_ba_inertial_refinements;
+  }
+  gba_requested_ = true;
+  // Deferred, the caller starts it where nothing writes the map.
+  if (!options_.defer_loop_correction) start_requested_global_ba();
+}
+
 bool LoopCloser::try_pause() {
   std::lock_guard lock(queue_mutex_);
   // A loop waiting for its correction holds keyframes and landmarks that reclamation would free.
@@ -389,6 +408,7 @@ bool LoopCloser::plausible(map::KeyFrame* query, map::KeyFrame* candidate, const
 
 void LoopCloser::process(map::KeyFrame* kf) {
   const bool loop_closed = close_loop(kf);
+  serve_inertial_refinement(*kf, loop_closed);
   long revisit = revisit_keyframe_;
   if (revisit < 0 || kf->id() < revisit) return;
   // Tracking may have asked again meanwhile (a second relocalization): that one waits for its own

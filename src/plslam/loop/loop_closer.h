@@ -108,6 +108,7 @@ struct LoopClosingStats {
   int global_ba_runs = 0;            // merged
   int global_ba_aborted = 0;         // made obsolete by a newer loop, or cut at finish()
   int global_ba_after_relocalization = 0;  // started for a relocalized revisit (no loop)
+  int global_ba_inertial_refinements = 0;  // started to refine the IMU's initialisation (no loop)
   int loops_across_relocalization = 0;     // of the loops, those closed across a relocalization
 };
 
@@ -129,6 +130,10 @@ class LoopCloser {
   // `before_loss_keyframe_id`: the reference keyframe of the last trusted frame before the loss, for
   // loop_across_relocalization (-1: none).
   void global_ba_after_keyframe(long keyframe_id, long before_loss_keyframe_id = -1);
+  // A visual-inertial map (use_imu) some seconds after the IMU's initialisation: once keyframe
+  // `keyframe_id` (or a later one) has passed through loop detection, a global BA with the IMU
+  // factors runs, unless that keyframe closed a loop (whose global BA is the same).
+  void refine_inertial_after_keyframe(long keyframe_id);
   // Processes every queued keyframe in the calling thread (sequential mode and tests).
   void process_pending();
   void wait_idle();
@@ -192,6 +197,8 @@ class LoopCloser {
   void start_deferred_global_ba();
   // Joins the global BA thread, cutting it short; a deferred result not merged yet is dropped.
   void abort_global_ba();
+  // Requests the global BA refine_inertial_after_keyframe() asked for, once `kf` reaches its id.
+  void serve_inertial_refinement(const map::KeyFrame& kf, bool loop_closed);
   // Writes a global BA's result into the map (unless it was aborted or is unusable, which is
   // counted) and records it; `t0`: when its snapshot was taken. True if merged.
   bool merge_into_map(const GlobalBaSnapshot& snapshot, const optim::BaResult& result,
@@ -205,6 +212,7 @@ class LoopCloser {
   long last_loop_keyframe_ = -1;
   std::atomic<long> revisit_keyframe_{-1};  // global_ba_after_keyframe()'s id, until served
   std::atomic<long> revisit_from_{-1};      // ... and the keyframe before the loss
+  std::atomic<long> refine_keyframe_{-1};   // refine_inertial_after_keyframe()'s id, until served
 
   mutable std::mutex queue_mutex_;
   std::condition_variable cv_;

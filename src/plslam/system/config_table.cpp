@@ -389,6 +389,11 @@ std::vector<ConfigKey> make_table() {
     field("imu", "max_inertial_s", [](auto& o) -> auto& { return o.tracker.imu.max_inertial_s; },
           "frames vision cannot track take the IMU's pose for at most this long, then the camera is lost",
           at_least(0)),
+    field("imu", "refine_after_s", [](auto& o) -> auto& { return o.imu_refine_after_s; },
+          "input seconds after the turn to stereo-inertial at which a global BA with the IMU factors refines gravity, "
+          "velocities and biases over the whole map (0: not; needs loop closing)", at_least(0)),
+    field("imu", "refine_again_after_s", [](auto& o) -> auto& { return o.imu_refine_again_after_s; },
+          "a second such refinement, this many input seconds after the turn (0: not)", at_least(0)),
     unsigned_field("system", "seed", [](auto& o) -> auto& { return o.seed; },
                    "seed of every random choice (the PnP RANSAC of relocalization and loop closing)", at_least(0)),
   };

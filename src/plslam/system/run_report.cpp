@@ -40,6 +40,7 @@ nlohmann::json loop_closing_json(const System& slam) {
   const auto s = slam.loop_closer()->stats();
   return {{"enabled", true}, {"detections", s.detections}, {"rejected", s.rejected}, {"implausible", s.implausible},
           {"global_ba_after_relocalization", s.global_ba_after_relocalization},
+          {"global_ba_inertial_refinements", s.global_ba_inertial_refinements},
           {"loops_across_relocalization", s.loops_across_relocalization}};
 }
 

@@ -147,6 +147,7 @@ FrameResult System::process(const io::StereoFrame& frame) {
   r.track = tracker_->track(std::move(data));
   r.tracking_ms = ms_since(t0);
   note_revisit(r.track);
+  note_inertial_refinement(r.track, frame.timestamp);
   // What the frame reports of the map: in deterministic mode before its keyframe's local mapping
   // starts beside the caller, so that it is the same in every run.
   auto pose_now = [&] {
@@ -192,6 +193,19 @@ void System::note_revisit(const tracking::TrackResult& track) {
     revisit_for_loop_closing_ = {reference->id(), revisit_from_};
   } else {
     loop_closer_->global_ba_after_keyframe(reference->id(), revisit_from_);
+  }
+}
+
+void System::note_inertial_refinement(const tracking::TrackResult& track, double timestamp) {
+  if (inertial_refinements_due_.empty() || !track.keyframe || timestamp < inertial_refinements_due_.front()) return;
+  const map::KeyFrame* reference = tracker_->records().empty() ? nullptr : tracker_->records().back().reference;
+  if (!reference) return;
+  inertial_refinements_due_.erase(inertial_refinements_due_.begin());
+  // Deterministic mode: told at the next meeting point, where loop closing is not running beside.
+  if (deterministic()) {
+    refinement_for_loop_closing_ = reference->id();
+  } else {
+    loop_closer_->refine_inertial_after_keyframe(reference->id());
   }
 }
 
@@ -246,6 +260,12 @@ void System::align_world_with_gravity(long frame_id) {
       tracker_->transform_world(T_new_old);
       gravity_alignment_ = GravityAlignment{T_new_old.rotation(), frame_id};
       start_visual_inertial();
+      if (options_.visual_inertial && loop_closer_) {
+        for (const double s : {options_.imu_refine_after_s, options_.imu_refine_again_after_s}) {
+          if (s > 0) inertial_refinements_due_.push_back(last_timestamp_ + s);
+        }
+        std::sort(inertial_refinements_due_.begin(), inertial_refinements_due_.end());
+      }
     }
     if (loop_closer_) loop_closer_->resume();
   }
@@ -416,6 +436,10 @@ void System::join_loop_job() {
 bool System::correction_open() const { return loop_closer_ && loop_closer_->correction_open(); }
 
 void System::tell_loop_closing_of_revisit() {
+  if (refinement_for_loop_closing_) {
+    loop_closer_->refine_inertial_after_keyframe(*refinement_for_loop_closing_);
+    refinement_for_loop_closing_.reset();
+  }
   if (!revisit_for_loop_closing_) return;
   loop_closer_->global_ba_after_keyframe(revisit_for_loop_closing_->first, revisit_for_loop_closing_->second);
   revisit_for_loop_closing_.reset();

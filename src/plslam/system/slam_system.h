@@ -59,6 +59,12 @@ struct SystemOptions {
   // Config imu.enabled: false leaves an input's IMU unused in `plslam run`, as --no-imu does
   // (stereo only, the world the first camera's; bench slam's `stereo` configuration).
   bool use_input_imu = true;
+  // Input seconds after the turn to stereo-inertial at which a global BA with the IMU factors
+  // refines gravity's direction, the keyframes' velocities and the biases over the whole map
+  // (ORB-SLAM3's VIBA 1 and 2): the initialisation saw a few seconds of motion, in which gravity's
+  // tilt and an accelerometer bias look alike. 0: not. Needs loop closing (its global BA).
+  double imu_refine_after_s = 5;
+  double imu_refine_again_after_s = 15;
 
   static SystemOptions euroc();
   static SystemOptions kitti();
@@ -172,6 +178,8 @@ class System {
   void reclaim_culled();
   // After a relocalization in the same map, asks loop closing for a global BA at the next keyframe.
   void note_revisit(const tracking::TrackResult& track);
+  // The first keyframe at or after a due inertial refinement asks loop closing for it.
+  void note_inertial_refinement(const tracking::TrackResult& track, double timestamp);
   // Deterministic mode. start_mapping_job() maps what the frame queued in mapping_job_: it first
   // finishes the keyframe before (its local BA's result, keyframe culling, loop closing), then
   // edits the map for the new one and, once the edits are done (wait_for_map_edits(), before the
@@ -237,6 +245,8 @@ class System {
   long correction_due_frame_ = -1;  // an open loop correction ends before this frame is tracked
   long steps_due_frame_ = -1;  // loop closing's steps wait for a frame with no local BA in flight, until this one
   std::optional<std::pair<long, long>> revisit_for_loop_closing_;  // global_ba_after_keyframe's arguments
+  std::optional<long> refinement_for_loop_closing_;  // refine_inertial_after_keyframe's argument
+  std::vector<double> inertial_refinements_due_;    // input times, ascending
   long seen_global_ba_starts_ = 0;
   double last_timestamp_ = 0;       // the last frame's input time
   double global_ba_merge_at_ = -1;  // input time of the pending global BA's merge (-1: none)
