@@ -435,7 +435,7 @@ void System::join_loop_job() {
 
 bool System::correction_open() const { return loop_closer_ && loop_closer_->correction_open(); }
 
-void System::tell_loop_closing_of_revisit() {
+void System::tell_loop_closing_of_requests() {
   if (refinement_for_loop_closing_) {
     loop_closer_->refine_inertial_after_keyframe(*refinement_for_loop_closing_);
     refinement_for_loop_closing_.reset();
@@ -447,7 +447,7 @@ void System::tell_loop_closing_of_revisit() {
 
 void System::run_loop_closing_steps(long frame_id) {
   if (!loop_closer_) return;
-  tell_loop_closing_of_revisit();
+  tell_loop_closing_of_requests();
   const bool end_due = loop_closer_->correction_open() && frame_id >= correction_due_frame_;
   const bool pending = loop_closer_->loop_pending();
   if (!end_due && !pending && !loop_closer_->global_ba_requested()) return;
@@ -500,7 +500,7 @@ void System::finish() {
   mapper_->wait_idle();
   mapper_->stop();
   if (loop_closer_) {
-    tell_loop_closing_of_revisit();
+    tell_loop_closing_of_requests();
     loop_closer_->finish();
     loop_closer_->stop();
   }

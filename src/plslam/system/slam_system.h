@@ -204,8 +204,9 @@ class System {
   void join_loop_job();
   void run_loop_closing_steps(long frame_id);
   bool correction_open() const;  // a loop correction has begun and not ended
-  // The revisit note_revisit() kept for a meeting point, handed to loop closing (needs loop_closer_).
-  void tell_loop_closing_of_revisit();
+  // What note_revisit() and note_inertial_refinement() kept for a meeting point (the global BAs they
+  // ask for), handed to loop closing (needs loop_closer_).
+  void tell_loop_closing_of_requests();
   // Deterministic mode: fixes the merge frame of a global BA that started, and merges it there.
   void merge_due_global_ba(long frame_id, double timestamp);
   bool deterministic() const;
