@@ -86,6 +86,32 @@ TEST(EurocReader, RectifiesAndConvertsGroundTruthToLeftCamera) {
   }
 }
 
+// Equidistant (Kannala-Brandt) cameras, as TUM-VI's sensor.yaml has them, are rectified with
+// OpenCV's fisheye model, and the reader keeps the raw rig for `plslam info`.
+TEST(EurocReader, RectifiesEquidistantFisheyeCameras) {
+  TempDir tmp;
+  const auto root = test::make_euroc(tmp.path(), 2);
+  for (const char* cam : {"cam0", "cam1"}) {
+    auto y = test::euroc_sensor_yaml(cam[3] == '0' ? 0.0 : 0.11);
+    y.replace(y.find("radial-tangential"), 17, "equidistant");
+    y.replace(y.find("[-0.1, 0.01, 0.0, 0.0]"), 22, "[0.0035, 0.0007, -0.002, 0.0002]");
+    test::write_file(root / "mav0" / cam / "sensor.yaml", y);
+  }
+  const auto ds = open_dataset(root);
+  EXPECT_NEAR(ds->calibration().baseline, 0.11, 1e-9);
+  ASSERT_TRUE(ds->raw_rig().has_value());
+  EXPECT_EQ(ds->raw_rig()->rig.left.model, geometry::LensModel::kEquidistant);
+  EXPECT_DOUBLE_EQ(ds->raw_rig()->rig.right.coeffs[3], 0.0002);
+  EXPECT_GT(ds->raw_rig()->coverage.kept_share, 0.5);
+  EXPECT_EQ(ds->load(1).left.size(), cv::Size(64, 48));
+  // A wider rectified view: a shorter focal length and more of the raw image kept.
+  DatasetOptions wide;
+  wide.rectify_balance = 1.0;
+  const auto wide_ds = open_dataset(root, wide);
+  EXPECT_LT(wide_ds->calibration().fx, ds->calibration().fx);
+  EXPECT_GT(wide_ds->raw_rig()->coverage.kept_share, ds->raw_rig()->coverage.kept_share);
+}
+
 TEST(EurocReader, DropsUnpairedImages) {
   TempDir tmp;
   const auto root = test::make_euroc(tmp.path(), 3);
@@ -300,6 +326,33 @@ const BadInput kBadInputs[] = {
        });
      },
      "sensor.yaml", "missing or malformed 'intrinsics'"},
+    {"euroc_unknown_distortion_model",
+     [](const fs::path& r) {
+       return euroc_with(r, [](const fs::path& m) {
+         auto y = test::euroc_sensor_yaml(0.0);
+         y.replace(y.find("radial-tangential"), 17, "omni");
+         test::write_file(m / "cam0" / "sensor.yaml", y);
+       });
+     },
+     "sensor.yaml", "unsupported distortion_model 'omni' (expected radial-tangential or equidistant)"},
+    {"euroc_distortion_folds_over",
+     [](const fs::path& r) {
+       return euroc_with(r, [](const fs::path& m) {
+         auto y = test::euroc_sensor_yaml(0.0);
+         y.replace(y.find("[-0.1, 0.01, 0.0, 0.0]"), 22, "[-2.0, 0.0, 0.0, 0.0]");
+         test::write_file(m / "cam0" / "sensor.yaml", y);
+       });
+     },
+     "sensor.yaml", "folds over inside the 64x48 image"},
+    {"euroc_lens_models_differ",
+     [](const fs::path& r) {
+       return euroc_with(r, [](const fs::path& m) {
+         auto y = test::euroc_sensor_yaml(0.11);
+         y.replace(y.find("radial-tangential"), 17, "equidistant");
+         test::write_file(m / "cam1" / "sensor.yaml", y);
+       });
+     },
+     "sensor.yaml", "lens models differ"},
     {"euroc_cameras_swapped",
      [](const fs::path& r) {
        return euroc_with(r, [](const fs::path& m) {

@@ -18,6 +18,7 @@ struct DatasetArgs {
   long long max_frames = -1;
   std::string imu;        // --imu FILE (add_imu_options)
   std::string imu_calib;  // --imu-calib FILE
+  double balance = 0.0;   // --balance
 
   io::DatasetOptions options() const {
     io::DatasetOptions o;
@@ -26,6 +27,7 @@ struct DatasetArgs {
     if (max_frames >= 0) o.max_frames = static_cast<std::size_t>(max_frames);
     o.imu_csv = imu;
     o.imu_calib = imu_calib;
+    o.rectify_balance = balance;
     return o;
   }
 };
@@ -48,6 +50,12 @@ inline void add_dataset_options(CLI::App& sub, DatasetArgs& args,
       ->capture_default_str();
   sub.add_option(max_frames_names, args.max_frames, "Use at most this many frames (-1: all)")
       ->check(CLI::Range(-1LL, kMaxFrameArg))
+      ->capture_default_str();
+  sub.add_option("--balance", args.balance,
+                 "Rectified field of view of an EuRoC-layout input (its images are rectified on reading): 0 keeps "
+                 "only pixels both cameras see, 1 the whole raw field of view along the image's middle lines, with "
+                 "black borders. A fisheye cannot be rectified whole: `plslam info` shows how much is kept")
+      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
 }
 

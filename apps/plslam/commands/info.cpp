@@ -84,6 +84,43 @@ std::string imu_text(const io::Dataset& ds) {
                      n.gyro_noise_density, n.gyro_random_walk, n.acc_noise_density, n.acc_random_walk);
 }
 
+nlohmann::json lens_json(const geometry::LensCamera& c) {
+  return {{"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx}, {"cy", c.cy}, {"distortion_coefficients", c.coeffs}};
+}
+
+// The raw cameras of an input rectified on reading; null for one that comes rectified.
+nlohmann::json raw_rig_json(const io::Dataset& ds) {
+  if (!ds.raw_rig()) return nullptr;
+  const auto& r = *ds.raw_rig();
+  const auto& cov = r.coverage;
+  return {{"model", geometry::to_string(r.rig.left.model)},
+          {"cam0", lens_json(r.rig.left)},
+          {"cam1", lens_json(r.rig.right)},
+          {"balance", r.balance},
+          {"raw_hfov_deg", cov.raw_hfov_deg},
+          {"raw_vfov_deg", cov.raw_vfov_deg},
+          {"rectified_hfov_deg", cov.rect_hfov_deg},
+          {"rectified_vfov_deg", cov.rect_vfov_deg},
+          {"kept_share", cov.kept_share},
+          {"blank_share", cov.blank_share}};
+}
+
+std::string raw_rig_text(const io::Dataset& ds) {
+  if (!ds.raw_rig()) return "raw cameras  none (the input comes rectified)\n";
+  const auto& r = *ds.raw_rig();
+  const auto& cov = r.coverage;
+  std::string out;
+  for (const auto* c : {&r.rig.left, &r.rig.right}) {
+    out += fmt::format("raw cam{}     {}: fx {:.3f}  fy {:.3f}  cx {:.3f}  cy {:.3f}  coefficients {:.6g}\n",
+                       c == &r.rig.left ? 0 : 1, geometry::to_string(c->model), c->fx, c->fy, c->cx, c->cy,
+                       fmt::join(c->coeffs, " "));
+  }
+  return out + fmt::format("field of view raw {:.1f} x {:.1f} deg, rectified {:.1f} x {:.1f} deg (balance {:.2f}): "
+                           "{:.1f} % of the raw left image kept, {:.1f} % of the rectified one blank\n",
+                           cov.raw_hfov_deg, cov.raw_vfov_deg, cov.rect_hfov_deg, cov.rect_vfov_deg, r.balance,
+                           100.0 * cov.kept_share, 100.0 * cov.blank_share);
+}
+
 int run_info(const InfoArgs& args) {
   check_input(args);
   const auto ds = args.video.empty() ? io::open_dataset(args.dataset.path, args.dataset.options())
@@ -105,6 +142,7 @@ int run_info(const InfoArgs& args) {
                         {"duration_s", duration},
                         {"has_ground_truth", ds->ground_truth().has_value()},
                         {"gt_path_length_m", ds->ground_truth_length()},
+                        {"raw_cameras", raw_rig_json(*ds)},
                         {"imu", imu_json(*ds)}};
     print_json(j.dump(2) + "\n");
     return 0;
@@ -116,7 +154,7 @@ int run_info(const InfoArgs& args) {
             << fmt::format("rate         {:.2f} fps\n", ds->fps())
             << fmt::format("duration     {:.2f} s\n", duration)
             << fmt::format("rectified    fx {:.3f}  fy {:.3f}  cx {:.3f}  cy {:.3f}\n", c.fx, c.fy, c.cx, c.cy)
-            << fmt::format("baseline     {:.4f} m  (bf {:.3f})\n", c.baseline, c.bf());
+            << fmt::format("baseline     {:.4f} m  (bf {:.3f})\n", c.baseline, c.bf()) << raw_rig_text(*ds);
   if (ds->ground_truth()) {
     std::cout << fmt::format("ground truth {} poses, {:.2f} m path  ({})\n", ds->ground_truth()->size(),
                              ds->ground_truth_length(), ds->ground_truth_path().string());

@@ -31,6 +31,8 @@ struct Options {
   double fps = 0;  // 0: the preset's
   bool motion_blur = false;
   std::string motion = "walk";
+  std::string camera = "pinhole";
+  double fov = 0;  // 0: the preset's focal length
   std::string imu_noise = "none";
   double imu_rate = 200;
   double imu_time_offset = 0;
@@ -112,18 +114,31 @@ int run(const Options& o) {
   so.loop_overlap = o.loop_overlap;
   so.motion_blur = o.motion_blur;
   so.motion = plslam::synth::parse_motion_profile(o.motion);
+  so.camera = plslam::synth::parse_camera_kind(o.camera);
+  so.fov_deg = o.fov;
   plslam::synth::ImuSynthOptions imu;
   imu.rate_hz = o.imu_rate;
   imu.noise_scale = plslam::synth::parse_imu_noise(o.imu_noise);
   imu.time_offset = o.imu_time_offset;
   const auto format = plslam::synth::parse_output_format(o.format.empty() ? o.preset : o.format);
   const plslam::synth::Sequence seq(so);  // checks the options first: they are the likelier mistake
+  if (format != plslam::synth::OutputFormat::kEuroc && so.camera != plslam::synth::CameraKind::kPinhole) {
+    throw plslam::InputError("--camera", fmt::format("a {} camera needs --format euroc: only its sensor.yaml holds a "
+                                                     "raw camera's calibration", o.camera));
+  }
   const fs::path out = checked_out_folder(o.out, o.force);
   plslam::app::install_stop_signals();
   spdlog::info("synth: {} scene, {} preset ({}x{} @ {:.4g} Hz, baseline {} m), {} frames, path {:.1f} m at {:.2f} m/s{}{}",
                o.scene, so.preset.name, so.preset.width, so.preset.height, so.preset.fps, so.preset.baseline,
                o.frames, seq.path().length(), seq.path().speed(), o.loop ? ", loop" : "",
                so.motion == plslam::synth::MotionProfile::kWalk ? "" : ", " + o.motion + " motion");
+  if (so.camera != plslam::synth::CameraKind::kPinhole || so.fov_deg != 0) {
+    const auto l = seq.lens(0);
+    const double diagonal = std::acos(l.unproject({0, 0})->z()) +
+                            std::acos(l.unproject({l.width - 1.0, l.height - 1.0})->z());
+    spdlog::info("synth: {} camera, fx {:.2f}, {:.1f} deg diagonal field of view", o.camera, l.fx,
+                 diagonal * 180.0 / M_PI);
+  }
   if (format == plslam::synth::OutputFormat::kEuroc) {
     spdlog::info("synth: IMU at {} Hz, noise {}{}", imu.rate_hz, o.imu_noise,
                  imu.time_offset != 0 ? fmt::format(", camera clock {:+.4f} s against the IMU's", imu.time_offset) : "");
@@ -192,6 +207,18 @@ plslam::cli::CommandRegistration register_synth_command({"synth", "Render a synt
                                                        "walk (the scene's own motion) | handheld (quick looks aside up "
                                                        "to 3 rad/s, hand shake) | drone (fast yaw turns, swoops with "
                                                        "tilt, vibration)")
+                                            ->capture_default_str();
+                                        sub.add_option("--camera", o->camera,
+                                                       "pinhole (an ideal rectified pair) | radtan (EuRoC-like "
+                                                       "radial-tangential lenses) | equidistant (TUM-VI-like fisheye "
+                                                       "lenses); radtan and equidistant make a real rig: intrinsics "
+                                                       "differ per camera, the right one is turned by 0.4 deg")
+                                            ->check(CLI::IsMember({"pinhole", "radtan", "equidistant"}))
+                                            ->capture_default_str();
+                                        sub.add_option("--fov", o->fov,
+                                                       "Diagonal field of view in degrees, which sets the focal length "
+                                                       "(0: the preset's)")
+                                            ->check(CLI::Range(0.0, 220.0))
                                             ->capture_default_str();
                                         sub.add_option("--imu-noise", o->imu_noise,
                                                        "EuRoC layout's IMU: none (exact, zero biases) | euroc (ADIS16448 "

@@ -13,6 +13,7 @@
 #include "plslam/core/error.h"
 #include "plslam/core/imu.h"
 #include "plslam/core/types.h"
+#include "plslam/geometry/stereo_rectification.h"
 
 namespace plslam::io {
 
@@ -50,6 +51,15 @@ struct DatasetOptions {
   // An IMU for a video (--imu, --imu-calib; see open_video_dataset), both or neither. A dataset
   // folder has its own (EuRoC's mav0/imu0) or none (KITTI): open_dataset refuses these.
   std::filesystem::path imu_csv, imu_calib;
+  // The rectified field of view of inputs rectified on reading (geometry/stereo_rectification.h).
+  double rectify_balance = 0.0;
+};
+
+// The raw cameras of an input that is rectified on reading, and what rectification kept of them.
+struct RawRig {
+  geometry::RawStereoRig rig;
+  double balance = 0;
+  geometry::RectificationCoverage coverage;
 };
 
 class Dataset {
@@ -74,6 +84,8 @@ class Dataset {
   // KITTI, whose images come rectified). Ground truth is given for the raw left sensor, as
   // datasets and published tables do: T_w_rect = T_w_sensor * R_rect_sensor^T.
   const Eigen::Matrix3d& rectification_rotation() const { return R_rect_sensor_; }
+  // The raw rig for inputs rectified on reading (EuRoC); nullopt for those that come rectified.
+  const std::optional<RawRig>& raw_rig() const { return raw_rig_; }
 
   // The input's IMU on the frames' clock, its samples cut to the selected frames plus
   // kImuMarginS (io/imu_input.h) on each side; nullopt without one (KITTI, an EuRoC sequence
@@ -92,6 +104,7 @@ class Dataset {
   std::optional<Trajectory> gt_;
   std::filesystem::path gt_path_;
   Eigen::Matrix3d R_rect_sensor_ = Eigen::Matrix3d::Identity();
+  std::optional<RawRig> raw_rig_;
   std::optional<ImuData> imu_;
   std::filesystem::path imu_path_;
 };

@@ -8,8 +8,6 @@
 
 #include <fmt/format.h>
 #include <Eigen/Core>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
@@ -61,10 +59,6 @@ std::vector<ImageEntry> read_image_list(const fs::path& csv) {
   return entries;
 }
 
-cv::Mat camera_matrix(const EurocCameraSensor& s) {
-  return (cv::Mat_<double>(3, 3) << s.fu, 0, s.cu, 0, s.fv, s.cv, 0, 0, 1);
-}
-
 class EurocDataset final : public Dataset {
  public:
   EurocDataset(const fs::path& mav0, const DatasetOptions& options) {
@@ -77,7 +71,7 @@ class EurocDataset final : public Dataset {
       throw InputError(yaml1.string(), fmt::format("resolution {}x{} differs from cam0's {}x{}", cam1.width,
                                                    cam1.height, cam0_.width, cam0_.height));
     }
-    compute_rectification(cam1, yaml1);
+    compute_rectification(cam1, yaml1, options.rectify_balance);
 
     const auto left = read_image_list(mav0 / "cam0" / "data.csv");
     const auto right = read_image_list(mav0 / "cam1" / "data.csv");
@@ -128,36 +122,21 @@ class EurocDataset final : public Dataset {
     std::string left, right;
   };
 
-  void compute_rectification(const EurocCameraSensor& cam1, const fs::path& yaml1) {
+  void compute_rectification(const EurocCameraSensor& cam1, const fs::path& yaml1, double balance) {
+    RawRig raw;
+    raw.rig.left = cam0_.lens();
+    raw.rig.right = cam1.lens();
     // p_c1 = T_BS1^-1 * T_BS0 * p_c0: the pose of cam0 in cam1's frame, as stereoRectify wants.
-    const Eigen::Isometry3d T_c1_c0 = cam1.T_BS.inverse() * cam0_.T_BS;
-    // Two cameras at one place give no depth (stereoRectify would assert); say so in plain words.
-    const double baseline = T_c1_c0.translation().norm();
-    if (!(baseline > 1e-6)) {
-      throw InputError(yaml1.string(), fmt::format("baseline must be positive, got {} m: T_BS places cam1 where "
-                                                   "cam0 is", baseline));
-    }
-    cv::Mat R, T;
-    cv::eigen2cv(Eigen::Matrix3d(T_c1_c0.rotation()), R);
-    cv::eigen2cv(Eigen::Vector3d(T_c1_c0.translation()), T);
-    const cv::Size size(cam0_.width, cam0_.height);
-    const cv::Mat K0 = camera_matrix(cam0_), K1 = camera_matrix(cam1);
-    const cv::Mat D0(cam0_.distortion), D1(cam1.distortion);
-    cv::Mat R1, R2, P1, P2, Q;
-    // alpha = 0 keeps only valid pixels, so no black borders produce spurious edges and corners.
-    cv::stereoRectify(K0, D0, K1, D1, size, R, T, R1, R2, P1, P2, Q, cv::CALIB_ZERO_DISPARITY, 0.0, size);
-    calib_.width = cam0_.width;
-    calib_.height = cam0_.height;
-    calib_.fx = P1.at<double>(0, 0);
-    calib_.fy = P1.at<double>(1, 1);
-    calib_.cx = P1.at<double>(0, 2);
-    calib_.cy = P1.at<double>(1, 2);
-    calib_.baseline = -P2.at<double>(0, 3) / P2.at<double>(0, 0);
-    // Baseline must come out positive: cam1 has to sit to the right of cam0.
+    raw.rig.T_right_left = cam1.T_BS.inverse() * cam0_.T_BS;
+    const auto rect = geometry::rectify_stereo(raw.rig, balance, yaml1.string());
+    calib_ = rect.calibration;
     validate_calibration(calib_, yaml1);
-    cv::cv2eigen(R1, R_rect_sensor_);
-    cv::initUndistortRectifyMap(K0, D0, R1, P1, size, CV_16SC2, map_left_[0], map_left_[1]);
-    cv::initUndistortRectifyMap(K1, D1, R2, P2, size, CV_16SC2, map_right_[0], map_right_[1]);
+    R_rect_sensor_ = rect.R_rect_left;
+    map_left_ = rect.map_left;
+    map_right_ = rect.map_right;
+    raw.balance = balance;
+    raw.coverage = rect.coverage;
+    raw_rig_ = raw;
   }
 
   void pair_images(const std::vector<ImageEntry>& left, const std::vector<ImageEntry>& right) {

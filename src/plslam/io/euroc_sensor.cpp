@@ -35,11 +35,20 @@ EurocCameraSensor parse_camera_yaml(const YAML::Node& root, const fs::path& path
   s.cv = k[3];
   if (s.fu <= 0 || s.fv <= 0) throw InputError(path.string(), "focal lengths must be positive");
   const std::string model = root["distortion_model"] ? root["distortion_model"].as<std::string>() : "radial-tangential";
-  if (model != "radial-tangential" && model != "radtan") {
-    throw InputError(path.string(), "unsupported distortion_model '" + model + "' (expected radial-tangential)");
+  const auto lens = geometry::parse_lens_model(model);
+  if (!lens) {
+    throw InputError(path.string(),
+                     "unsupported distortion_model '" + model + "' (expected radial-tangential or equidistant)");
   }
+  s.distortion_model = *lens;
   const auto d = sensor_numbers(root["distortion_coefficients"], "distortion_coefficients", 4, path);
   std::copy(d.begin(), d.end(), s.distortion.begin());
+  // Rectification needs the ray of every border pixel; a distortion that folds over inside the
+  // image (a fit extrapolated past the calibration's data) would give wrong rays there.
+  if (!s.lens().max_ray_angle()) {
+    throw InputError(path.string(), fmt::format("the {} distortion {} folds over inside the {}x{} image: some pixels "
+                                                "have no ray", model, fmt::join(d, ", "), s.width, s.height));
+  }
   if (root["rate_hz"]) s.rate_hz = root["rate_hz"].as<double>();
   return s;
 }

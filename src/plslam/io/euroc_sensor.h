@@ -1,12 +1,14 @@
 #pragma once
-// The ASL/EuRoC camera sensor.yaml: intrinsics, radial-tangential distortion and T_BS, the pose
-// of the sensor in the body frame (p_body = T_BS * p_sensor).
+// The ASL/EuRoC camera sensor.yaml (also TUM-VI's and Kalibr's camchain fields): a pinhole
+// projection with radial-tangential or equidistant (Kannala-Brandt fisheye) distortion, and T_BS,
+// the pose of the sensor in the body frame (p_body = T_BS * p_sensor).
 #include <array>
 #include <filesystem>
 
 #include <Eigen/Geometry>
 
 #include "plslam/core/types.h"
+#include "plslam/geometry/lens_model.h"
 
 namespace plslam::io {
 
@@ -15,8 +17,11 @@ struct EurocCameraSensor {
   int width = 0;
   int height = 0;
   double fu = 0, fv = 0, cu = 0, cv = 0;
-  std::array<double, 4> distortion{};  // k1, k2, p1, p2
+  geometry::LensModel distortion_model = geometry::LensModel::kRadialTangential;
+  std::array<double, 4> distortion{};  // k1, k2, p1, p2 (radial-tangential) or k1..k4 (equidistant)
   double rate_hz = 0;
+
+  geometry::LensCamera lens() const { return {distortion_model, width, height, fu, fv, cu, cv, distortion}; }
 };
 
 // Throws InputError naming the file on a missing file, malformed YAML, missing keys, wrong sizes,

@@ -2,6 +2,7 @@
 // A synthetic stereo sequence: scene + camera preset + trajectory + sensor model. Frames are
 // rendered on demand and independently (any order, any thread with its own StereoRenderer),
 // and always give the same bytes for the same options.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -10,6 +11,8 @@
 #include <opencv2/core.hpp>
 
 #include "plslam/core/types.h"
+#include "plslam/geometry/lens_model.h"
+#include "plslam/synth/lens_renderer.h"
 #include "plslam/synth/renderer.h"
 #include "plslam/synth/scene.h"
 #include "plslam/synth/sensor.h"
@@ -29,6 +32,13 @@ CameraPreset euroc_preset();  // 752x480, 20 Hz, fx 458, baseline 0.11 m
 CameraPreset kitti_preset();  // 1241x376, 10 Hz, fx 718, baseline 0.54 m
 CameraPreset parse_preset(const std::string& name);  // euroc|kitti; InputError otherwise
 
+// pinhole: the ideal rectified pair (no distortion, parallel cameras). radtan and equidistant: a
+// real rig, as a calibration finds one: EuRoC-like radial-tangential or TUM-VI-like equidistant
+// lenses with slightly different intrinsics per camera, and the right camera turned by 0.4 degrees.
+enum class CameraKind { kPinhole, kRadialTangential, kEquidistant };
+CameraKind parse_camera_kind(const std::string& name);  // pinhole|radtan|equidistant; InputError otherwise
+const char* to_string(CameraKind kind);
+
 struct SequenceOptions {
   SceneKind scene = SceneKind::kOffice;
   CameraPreset preset = euroc_preset();
@@ -40,6 +50,9 @@ struct SequenceOptions {
   double loop_overlap = 0.03;  // with loop: share of the path travelled again after the return, in [0, 1]
   bool motion_blur = false;  // integrate over the shutter time, proportional to the motion
   MotionProfile motion = MotionProfile::kWalk;
+  CameraKind camera = CameraKind::kPinhole;
+  // Diagonal field of view in degrees, which sets the focal length; 0 keeps the preset's.
+  double fov_deg = 0;
 };
 
 class Sequence {
@@ -50,8 +63,11 @@ class Sequence {
   const Scene& scene() const { return scene_; }
   const CameraPath& path() const { return path_; }
   const SensorModel& sensor() const { return sensor_; }
+  // The rectified calibration: of an ideal pair (CameraKind::kPinhole) only, InputError otherwise.
   StereoCalibration calibration() const;
-  PinholeCamera camera() const;
+  geometry::LensCamera lens(int cam) const;  // cam 0: left, 1: right
+  // The right camera's pose in the left camera's frame (p_left = T_left_right * p_right).
+  const Eigen::Isometry3d& T_left_right() const { return T_lr_; }
   std::size_t size() const { return static_cast<std::size_t>(options_.frames); }
   double time(std::size_t i) const { return static_cast<double>(i) / options_.preset.fps; }
   Eigen::Isometry3d left_pose(std::size_t i) const { return path_.pose(time(i)); }  // T_world_left
@@ -62,6 +78,8 @@ class Sequence {
   Scene scene_;
   CameraPath path_;
   SensorModel sensor_;
+  std::array<geometry::LensCamera, 2> lens_;
+  Eigen::Isometry3d T_lr_;
 };
 
 struct StereoImages {
@@ -76,10 +94,10 @@ class StereoRenderer {
   StereoImages render(std::size_t i, bool with_depth = false);
 
  private:
-  void render_camera(const Eigen::Isometry3d& T_lr, std::size_t i, cv::Mat& radiance, cv::Mat* depth);
+  void render_camera(int cam, std::size_t i, cv::Mat& radiance, cv::Mat* depth);
 
   const Sequence& seq_;
-  Renderer renderer_;
+  std::array<LensRenderer, 2> renderers_;
   cv::Mat radiance_, accum_;
 };
 

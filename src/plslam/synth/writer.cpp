@@ -77,15 +77,23 @@ std::string matrix_yaml(const Eigen::Isometry3d& T) {
 
 void write_sensor_yaml(const fs::path& p, const Sequence& seq, const Eigen::Isometry3d& T_BS, int cam) {
   const auto& pr = seq.options().preset;
+  const geometry::LensCamera l = seq.lens(cam);
+  const bool ideal = seq.options().camera == CameraKind::kPinhole;
   auto out = open_out(p);
   out << "%YAML:1.0\n# General sensor definitions.\nsensor_type: camera\n"
-      << "comment: plslam synth cam" << cam << " (ideal rectified pinhole)\n\n"
+      << "comment: plslam synth cam" << cam << (ideal ? " (ideal rectified pinhole)" : fmt::format(" ({} lens)", to_string(seq.options().camera)))
+      << "\n\n"
       << "# Sensor extrinsics wrt. the body-frame.\nT_BS:\n" << matrix_yaml(T_BS) << "\n"
       << "# Camera specific definitions.\n"
-      << fmt::format("rate_hz: {}\n", pr.fps) << fmt::format("resolution: [{}, {}]\n", pr.width, pr.height)
+      << fmt::format("rate_hz: {}\n", pr.fps) << fmt::format("resolution: [{}, {}]\n", l.width, l.height)
       << "camera_model: pinhole\n"
-      << fmt::format("intrinsics: [{:.17g}, {:.17g}, {:.17g}, {:.17g}] #fu, fv, cu, cv\n", pr.fx, pr.fy, pr.cx, pr.cy)
-      << "distortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n";
+      << fmt::format("intrinsics: [{:.17g}, {:.17g}, {:.17g}, {:.17g}] #fu, fv, cu, cv\n", l.fx, l.fy, l.cx, l.cy);
+  if (ideal) {
+    out << "distortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n";
+  } else {
+    out << fmt::format("distortion_model: {}\ndistortion_coefficients: [{:.17g}, {:.17g}, {:.17g}, {:.17g}]\n",
+                       geometry::to_string(l.model), l.coeffs[0], l.coeffs[1], l.coeffs[2], l.coeffs[3]);
+  }
 }
 
 void write_imu(const SyntheticImu& imu, const fs::path& dir) {
@@ -156,11 +164,15 @@ void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const E
   nlohmann::json j = {{"scene", to_string(o.scene)}, {"preset", o.preset.name}, {"frames", o.frames},
                       {"seed", o.seed},   {"loop", o.loop},  {"loop_overlap", o.loop_overlap}, {"motion_blur", o.motion_blur},
                       {"fps", o.preset.fps}, {"width", o.preset.width}, {"height", o.preset.height},
-                      {"fx", o.preset.fx}, {"fy", o.preset.fy}, {"cx", o.preset.cx}, {"cy", o.preset.cy},
+                      {"fx", seq.lens(0).fx}, {"fy", seq.lens(0).fy}, {"cx", seq.lens(0).cx}, {"cy", seq.lens(0).cy},
                       {"baseline_m", o.preset.baseline}, {"path_length_m", seq.path().length()},
                       {"speed_mps", seq.path().speed()}, {"frame", frame_name}};
   j["path_seed"] = o.path_seed;
   j["motion"] = to_string(o.motion);
+  if (o.camera != CameraKind::kPinhole || o.fov_deg != 0) {
+    j["camera"] = to_string(o.camera);
+    j["fov_deg"] = o.fov_deg;
+  }
   if (imu) {
     const auto& io = imu->options();
     const Eigen::Vector3d &bg = imu->initial_gyro_bias(), &ba = imu->initial_acc_bias();
@@ -283,13 +295,14 @@ std::uint64_t imu_seed(const SequenceOptions& o) { return o.seed * 0x2545F4914F6
 
 bool write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat format, const Progress& progress,
                     int threads, const Cancelled& cancelled, const ImuSynthOptions& imu_options) {
+  // KITTI and video hold a rectified pair's calibration only: refuse a raw rig before rendering.
+  if (format != OutputFormat::kEuroc) (void)seq.calibration();
   if (format == OutputFormat::kVideo) return write_video(seq, dir, progress, threads, cancelled);
   const std::size_t n = seq.size();
   if (format == OutputFormat::kEuroc) {
     const fs::path mav = dir / "mav0";
     const Eigen::Isometry3d T_BS0 = euroc_T_BS_cam0();
-    Eigen::Isometry3d T_c0c1 = Eigen::Isometry3d::Identity();
-    T_c0c1.translation().x() = seq.options().preset.baseline;
+    const Eigen::Isometry3d T_c0c1 = seq.T_left_right();
     std::vector<double> times;
     for (int cam = 0; cam < 2; ++cam) {
       const fs::path cdir = mav / fmt::format("cam{}", cam);
@@ -316,7 +329,7 @@ bool write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat forma
   const fs::path sdir = dir / "sequences" / "00";
   fs::create_directories(sdir / "image_0");
   fs::create_directories(sdir / "image_1");
-  const auto& pr = seq.options().preset;
+  const StereoCalibration pr = seq.calibration();
   {
     auto calib = open_out(sdir / "calib.txt");
     for (int cam = 0; cam < 2; ++cam) {
