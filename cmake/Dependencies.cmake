@@ -1,5 +1,5 @@
 # Every dependency comes from a Debian 12 package (scripts/install-deps.sh).
-set(PLSLAM_OPENCV_COMPONENTS core imgproc imgcodecs videoio features2d calib3d line_descriptor ximgproc)
+set(PLSLAM_OPENCV_COMPONENTS core imgproc imgcodecs videoio features2d calib3d line_descriptor ximgproc aruco)
 find_package(OpenCV 4.6 REQUIRED COMPONENTS ${PLSLAM_OPENCV_COMPONENTS})
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 find_package(Ceres 2.1 REQUIRED)

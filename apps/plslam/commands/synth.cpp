@@ -12,13 +12,14 @@
 #include "plslam/core/error.h"
 #include "plslam/core/log.h"
 #include "plslam/io/output_folder.h"
+#include "plslam/calib/board.h"
 #include "plslam/synth/writer.h"
 #include "progress_eta.h"
 #include "stop_signals.h"
 
 namespace {
 
-struct Options {
+struct SynthArgs {
   std::string out;
   std::string scene = "office";
   std::string format;  // default: the preset's own layout
@@ -32,6 +33,7 @@ struct Options {
   bool motion_blur = false;
   std::string motion = "walk";
   std::string camera = "pinhole";
+  std::string board = plslam::calib::to_string(plslam::calib::BoardSpec{});
   double fov = 0;  // 0: the preset's focal length
   std::string imu_noise = "none";
   double imu_rate = 200;
@@ -102,7 +104,7 @@ fs::path checked_out_folder(const std::string& given, bool force) {
   return out;
 }
 
-int run(const Options& o) {
+int run_synth(const SynthArgs& o) {
   plslam::synth::SequenceOptions so;
   so.scene = plslam::synth::parse_scene_kind(o.scene);
   so.preset = plslam::synth::parse_preset(o.preset);
@@ -116,6 +118,7 @@ int run(const Options& o) {
   so.motion = plslam::synth::parse_motion_profile(o.motion);
   so.camera = plslam::synth::parse_camera_kind(o.camera);
   so.fov_deg = o.fov;
+  so.board = plslam::calib::parse_board_spec(o.board);
   plslam::synth::ImuSynthOptions imu;
   imu.rate_hz = o.imu_rate;
   imu.noise_scale = plslam::synth::parse_imu_noise(o.imu_noise);
@@ -172,9 +175,11 @@ int run(const Options& o) {
 
 plslam::cli::CommandRegistration register_synth_command({"synth", "Render a synthetic stereo sequence with exact ground truth",
                                       [](CLI::App& sub) {
-                                        auto o = std::make_shared<Options>();
+                                        auto o = std::make_shared<SynthArgs>();
                                         sub.add_option("--out", o->out, "Output folder")->required();
-                                        sub.add_option("--scene", o->scene, "office|corridor|street")
+                                        sub.add_option("--scene", o->scene,
+                                                       "office|corridor|street|calibration (a calibration board, "
+                                                       "--board, waved in front of the rig: still views, no IMU)")
                                             ->capture_default_str();
                                         sub.add_option("--frames", o->frames, "Number of stereo frames")
                                             ->capture_default_str()
@@ -215,6 +220,10 @@ plslam::cli::CommandRegistration register_synth_command({"synth", "Render a synt
                                                        "differ per camera, the right one is turned by 0.4 deg")
                                             ->check(CLI::IsMember({"pinhole", "radtan", "equidistant"}))
                                             ->capture_default_str();
+                                        sub.add_option("--board", o->board,
+                                                       "The calibration scene's board: charuco:COLSxROWS:SQUARE_M:"
+                                                       "MARKER_M[:DICT] or chessboard:COLSxROWS:SQUARE_M (squares)")
+                                            ->capture_default_str();
                                         sub.add_option("--fov", o->fov,
                                                        "Diagonal field of view in degrees, which sets the focal length "
                                                        "(0: the preset's)")
@@ -235,7 +244,7 @@ plslam::cli::CommandRegistration register_synth_command({"synth", "Render a synt
                                         sub.add_option("--threads", o->threads, "Rendering threads (0: all cores)")
                                             ->check(CLI::Range(0, 1024))
                                             ->capture_default_str();
-                                        return std::function<int()>([o] { return run(*o); });
+                                        return std::function<int()>([o] { return run_synth(*o); });
                                       }});
 
 }  // namespace

@@ -14,6 +14,7 @@ const char* to_string(SceneKind s) {
     case SceneKind::kOffice: return "office";
     case SceneKind::kCorridor: return "corridor";
     case SceneKind::kStreet: return "street";
+    case SceneKind::kCalibration: return "calibration";
   }
   return "?";
 }
@@ -22,7 +23,8 @@ SceneKind parse_scene_kind(const std::string& name) {
   if (name == "office") return SceneKind::kOffice;
   if (name == "corridor") return SceneKind::kCorridor;
   if (name == "street") return SceneKind::kStreet;
-  throw InputError("", "unknown scene '" + name + "' (expected office, corridor or street)");
+  if (name == "calibration") return SceneKind::kCalibration;
+  throw InputError("", "unknown scene '" + name + "' (expected office, corridor, street or calibration)");
 }
 
 int Scene::add_texture(Texture t) {

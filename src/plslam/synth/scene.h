@@ -37,10 +37,10 @@ struct Segment3d {
   Eigen::Vector3d a, b;
 };
 
-enum class SceneKind { kOffice, kCorridor, kStreet };
+enum class SceneKind { kOffice, kCorridor, kStreet, kCalibration };
 
 const char* to_string(SceneKind s);
-SceneKind parse_scene_kind(const std::string& name);  // office|corridor|street; InputError else
+SceneKind parse_scene_kind(const std::string& name);  // office|corridor|street|calibration; InputError else
 
 struct Scene {
   SceneKind kind = SceneKind::kOffice;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "plslam/synth/scene.h"
+#include "plslam/synth/calibration_scene.h"
 
 namespace plslam::synth {
 
@@ -411,6 +412,7 @@ Scene build_scene(SceneKind kind, std::uint64_t seed) {
     case SceneKind::kOffice: return office(seed);
     case SceneKind::kCorridor: return corridor(seed);
     case SceneKind::kStreet: return street(seed);
+    case SceneKind::kCalibration: return calibration_scene(calib::BoardSpec{}, seed);
   }
   return office(seed);
 }

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "plslam/core/error.h"
+#include "plslam/synth/calibration_scene.h"
 
 namespace plslam::synth {
 
@@ -119,7 +120,8 @@ double choose_speed(const Scene& scene, const SequenceOptions& o) {
 
 Sequence::Sequence(const SequenceOptions& options)
     : options_(options),
-      scene_(build_scene(options.scene, options.seed)),
+      scene_(options.scene == SceneKind::kCalibration ? calibration_scene(options.board, options.seed)
+                                                       : build_scene(options.scene, options.seed)),
       path_(scene_, choose_speed(scene_, options), options.seed, options.path_seed, options.motion),
       sensor_(options.preset.width, options.preset.height, options.seed),
       lens_(make_lenses(options)),
@@ -130,6 +132,10 @@ Sequence::Sequence(const SequenceOptions& options)
       throw InputError("", fmt::format("the {} lens with --fov {} folds over inside the image", to_string(options.camera),
                                        options.fov_deg));
     }
+  }
+  if (options.scene == SceneKind::kCalibration) {
+    if (options.motion_blur) throw InputError("--motion-blur", "the calibration scene's frames are still views");
+    views_ = calibration_views(options.board, lens_[0], options.frames, options.seed);
   }
 }
 
@@ -162,7 +168,7 @@ void StereoRenderer::render_camera(int cam, std::size_t i, cv::Mat& radiance, cv
   LensRenderer& renderer = renderers_[static_cast<std::size_t>(cam)];
   const double t = seq_.time(i);
   if (!seq_.options().motion_blur) {
-    renderer.render(seq_.path().pose(t) * T_lr, radiance, depth);
+    renderer.render(seq_.left_pose(i) * T_lr, radiance, depth);
     return;
   }
   // Shutter open for 12 ms around t; as many sub-frames as the fastest image point moves

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "plslam/calib/board.h"
 #include "plslam/core/types.h"
 #include "plslam/geometry/lens_model.h"
 #include "plslam/synth/lens_renderer.h"
@@ -53,6 +54,7 @@ struct SequenceOptions {
   CameraKind camera = CameraKind::kPinhole;
   // Diagonal field of view in degrees, which sets the focal length; 0 keeps the preset's.
   double fov_deg = 0;
+  calib::BoardSpec board;  // SceneKind::kCalibration's board
 };
 
 class Sequence {
@@ -70,7 +72,9 @@ class Sequence {
   const Eigen::Isometry3d& T_left_right() const { return T_lr_; }
   std::size_t size() const { return static_cast<std::size_t>(options_.frames); }
   double time(std::size_t i) const { return static_cast<double>(i) / options_.preset.fps; }
-  Eigen::Isometry3d left_pose(std::size_t i) const { return path_.pose(time(i)); }  // T_world_left
+  // T_world_left: on the path, or the calibration scene's views.
+  Eigen::Isometry3d left_pose(std::size_t i) const { return views_.empty() ? path_.pose(time(i)) : views_.at(i); }
+  bool has_path() const { return views_.empty(); }  // a continuous motion (and an IMU) rather than views
   Eigen::Isometry3d right_pose(std::size_t i) const;
 
  private:
@@ -80,6 +84,7 @@ class Sequence {
   SensorModel sensor_;
   std::array<geometry::LensCamera, 2> lens_;
   Eigen::Isometry3d T_lr_;
+  std::vector<Eigen::Isometry3d> views_;
 };
 
 struct StereoImages {

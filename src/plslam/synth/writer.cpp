@@ -6,6 +6,8 @@
 #include <fstream>
 #include <mutex>
 
+#include <optional>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -169,6 +171,7 @@ void write_ground_truth_extras(const Sequence& seq, const fs::path& dir, const E
                       {"speed_mps", seq.path().speed()}, {"frame", frame_name}};
   j["path_seed"] = o.path_seed;
   j["motion"] = to_string(o.motion);
+  if (o.scene == SceneKind::kCalibration) j["board"] = calib::to_string(o.board);
   if (o.camera != CameraKind::kPinhole || o.fov_deg != 0) {
     j["camera"] = to_string(o.camera);
     j["fov_deg"] = o.fov_deg;
@@ -313,9 +316,13 @@ bool write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat forma
       write_sensor_yaml(cdir / "sensor.yaml", seq, cam == 0 ? T_BS0 : T_BS0 * T_c0c1, cam);
     }
     for (std::size_t i = 0; i < n; ++i) times.push_back(static_cast<double>(euroc_timestamp_ns(seq, i)) * 1e-9);
-    const SyntheticImu imu(seq, T_BS0, imu_options, imu_seed(seq.options()));  // IMU = body frame
-    write_imu(imu, mav / "imu0");
-    write_state_ground_truth(seq, imu, mav / "state_groundtruth_estimate0" / "data.csv");
+    // Still views (the calibration scene) have no motion to measure: no IMU, no body trajectory.
+    std::optional<SyntheticImu> imu;
+    if (seq.has_path()) {
+      imu.emplace(seq, T_BS0, imu_options, imu_seed(seq.options()));  // IMU = body frame
+      write_imu(*imu, mav / "imu0");
+      write_state_ground_truth(seq, *imu, mav / "state_groundtruth_estimate0" / "data.csv");
+    }
     const bool complete = render_all(seq, progress, threads, cancelled, [&](std::size_t i, const StereoImages& im) {
       const std::string name = fmt::format("{}.png", euroc_timestamp_ns(seq, i));
       write_png(mav / "cam0" / "data" / name, im.left);
@@ -323,7 +330,8 @@ bool write_sequence(const Sequence& seq, const fs::path& dir, OutputFormat forma
     });
     if (!complete) return false;
     // Last, so that synth/synth.json marks a complete sequence.
-    write_ground_truth_extras(seq, mav / "synth", Eigen::Isometry3d::Identity(), times, "euroc world (z up)", &imu);
+    write_ground_truth_extras(seq, mav / "synth", Eigen::Isometry3d::Identity(), times, "euroc world (z up)",
+                              imu ? &*imu : nullptr);
     return true;
   }
   const fs::path sdir = dir / "sequences" / "00";
