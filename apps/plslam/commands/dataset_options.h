@@ -52,7 +52,7 @@ inline void add_dataset_options(CLI::App& sub, DatasetArgs& args,
       ->check(CLI::Range(-1LL, kMaxFrameArg))
       ->capture_default_str();
   sub.add_option("--balance", args.balance,
-                 "Rectified field of view of an EuRoC-layout input (its images are rectified on reading): 0 keeps "
+                 "Rectified field of view of an input rectified on reading (an EuRoC folder, or a raw --calib): 0 keeps "
                  "only pixels both cameras see, 1 the whole raw field of view along the image's middle lines, with "
                  "black borders. A fisheye cannot be rectified whole: `plslam info` shows how much is kept")
       ->check(CLI::Range(0.0, 1.0))

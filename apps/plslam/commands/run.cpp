@@ -102,9 +102,6 @@ void check_input_args(const RunArgs& a) {
                                      : "give one input only: a dataset folder, --video FILE or --camera DEVICE");
   }
   if (a.dataset.path.empty() && a.calib.empty()) throw InputError("", "--video and --camera need --calib FILE");
-  if (!a.dataset.path.empty() && !a.calib.empty()) {
-    throw InputError("", "--calib is for --video and --camera (a dataset folder has its own calibration)");
-  }
   if (a.dataset.path.empty() && a.dataset.format != "auto") throw InputError("", "--format is for dataset folders");
   if (!a.camera.empty() && a.dataset.start != 0) throw InputError("", "--start is not for a live camera");
   check_imu_args(a.dataset);
@@ -113,18 +110,28 @@ void check_input_args(const RunArgs& a) {
 RunInput open_input(const RunArgs& args) {
   RunInput in;
   if (!args.camera.empty()) {
-    in.calibration = io::read_calibration_file(args.calib);
+    const io::UserCalibration user = io::read_user_calibration(args.calib);
+    const io::InputRectification rect = io::rectify_user_calibration(user, args.dataset.balance, args.calib);
+    in.calibration = rect.calibration;
+    // The camera's raw frames are the size of the calibration's images, rectified or not.
+    StereoCalibration frame_size = in.calibration;
+    frame_size.width = user.width();
+    frame_size.height = user.height();
+    Eigen::Isometry3d T_body_rect = Eigen::Isometry3d::Identity();  // body: the (raw) left camera
+    if (rect.rectification) T_body_rect.linear() = rect.rectification->R_rect_left.transpose();
     if (!args.dataset.imu.empty()) {
-      // The camera's frames are the body frame; how long the camera runs is not known ahead, so
-      // the samples are not cut to its frames.
-      in.camera_imu = io::read_imu(args.dataset.imu, args.dataset.imu_calib, Eigen::Isometry3d::Identity());
+      // How long the camera runs is not known ahead, so the samples are not cut to its frames.
+      in.camera_imu = io::read_imu(args.dataset.imu, args.dataset.imu_calib, T_body_rect);
     }
-    in.camera = io::open_stereo_camera(args.camera, args.camera_right, in.calibration);
+    in.camera = io::open_stereo_camera(args.camera, args.camera_right, frame_size);
+    if (rect.rectification) in.camera = io::rectify_frames(std::move(in.camera), *rect.rectification);
     in.name = in.camera->name();
     return in;
   }
-  in.dataset = args.video.empty() ? io::open_dataset(args.dataset.path, args.dataset.options())
-                                  : io::open_video_dataset(args.video, args.calib, args.dataset.options());
+  io::DatasetOptions options = args.dataset.options();
+  if (args.video.empty()) options.calibration = args.calib;
+  in.dataset = args.video.empty() ? io::open_dataset(args.dataset.path, options)
+                                  : io::open_video_dataset(args.video, args.calib, options);
   in.calibration = in.dataset->calibration();
   in.format = in.dataset->format();
   in.name = in.dataset->root().string();
@@ -580,8 +587,10 @@ CommandRegistration register_run_command({"run", "Run stereo point-line SLAM on 
                            sub.add_option("--camera-right", args->camera_right, "The right camera's device")
                                ->needs(camera);
                            sub.add_option("--calib", args->calib,
-                                          "Stereo calibration of the rectified images, for --video and --camera "
-                                          "(YAML: width height fx fy cx cy baseline)");
+                                          "Stereo calibration: of the rectified images (YAML: width height fx fy cx "
+                                          "cy baseline), or of the raw cameras as plslam calibrate writes it (Kalibr's "
+                                          "camchain.yaml). Needed for --video and --camera; for an EuRoC folder it "
+                                          "replaces the two sensor.yaml");
                            add_imu_options(sub, args->dataset);
                            sub.add_option("--preset", args->preset,
                                           "Configuration preset (default: kitti for KITTI datasets, else euroc)")

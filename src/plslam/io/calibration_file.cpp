@@ -10,6 +10,8 @@
 #include "plslam/core/error.h"
 #include "plslam/core/input_file.h"
 #include "plslam/io/atomic_file.h"
+#include "plslam/io/camchain_file.h"
+#include "plslam/io/sensor_yaml.h"
 
 namespace plslam::io {
 
@@ -28,9 +30,23 @@ T read_positive(const ConfigReader& reader, const char* key, const char* meaning
   return value;
 }
 
+// A file that does not parse as a mapping is left to the rectified form's reader, whose errors
+// name the problem in its terms.
+bool holds_camchain(const std::filesystem::path& path) {
+  try {
+    return is_camchain(detail::load_sensor_yaml(path, "calibration file not found"));
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
 }  // namespace
 
 StereoCalibration read_calibration_file(const std::filesystem::path& path) {
+  if (holds_camchain(path)) {
+    throw InputError(path.string(), "holds raw cameras (cam0, cam1); this input needs the rectified calibration "
+                                    "(width, height, fx, fy, cx, cy, baseline)");
+  }
   std::ifstream in = open_text_file(path, "calibration file not found");
   std::stringstream text;
   text << in.rdbuf();
@@ -45,6 +61,28 @@ StereoCalibration read_calibration_file(const std::filesystem::path& path) {
   c.baseline = read_positive<double>(reader, "baseline", "metres, -P2(0,3) / P2(0,0)");
   reader.check_all_used();
   return c;
+}
+
+UserCalibration read_user_calibration(const std::filesystem::path& path) {
+  UserCalibration c;
+  if (holds_camchain(path)) {
+    c.raw = read_camchain_file(path);
+  } else {
+    c.rectified = read_calibration_file(path);
+  }
+  return c;
+}
+
+InputRectification rectify_user_calibration(const UserCalibration& calibration, double balance,
+                                            const std::filesystem::path& source) {
+  InputRectification out;
+  if (calibration.rectified) {
+    out.calibration = *calibration.rectified;
+    return out;
+  }
+  out.rectification = geometry::rectify_stereo(*calibration.raw, balance, source.string());
+  out.calibration = out.rectification->calibration;
+  return out;
 }
 
 void write_calibration_file(const std::filesystem::path& path, const StereoCalibration& c) {

@@ -1,10 +1,12 @@
 #include "plslam/io/camera_source.h"
 
+#include <array>
 #include <chrono>
 #include <filesystem>
 #include <thread>
 
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "plslam/core/error.h"
@@ -121,6 +123,36 @@ std::unique_ptr<FrameSource> open_stereo_camera(const std::string& device, const
     return std::make_unique<VideoFileCamera>(device, calibration);
   }
   return std::make_unique<V4l2StereoCamera>(device, right_device, calibration);
+}
+
+namespace {
+
+class RectifyingSource final : public FrameSource {
+ public:
+  RectifyingSource(std::unique_ptr<FrameSource> raw, const geometry::StereoRectification& r)
+      : raw_(std::move(raw)), map_left_(r.map_left), map_right_(r.map_right) {}
+
+  std::optional<CapturedFrame> capture() override {
+    auto frame = raw_->capture();
+    if (!frame) return frame;
+    CapturedFrame out;
+    out.timestamp = frame->timestamp;
+    cv::remap(frame->left, out.left, map_left_[0], map_left_[1], cv::INTER_LINEAR);
+    cv::remap(frame->right, out.right, map_right_[0], map_right_[1], cv::INTER_LINEAR);
+    return out;
+  }
+  std::string name() const override { return raw_->name(); }
+
+ private:
+  std::unique_ptr<FrameSource> raw_;
+  std::array<cv::Mat, 2> map_left_, map_right_;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> rectify_frames(std::unique_ptr<FrameSource> raw,
+                                            const geometry::StereoRectification& rectification) {
+  return std::make_unique<RectifyingSource>(std::move(raw), rectification);
 }
 
 }  // namespace plslam::io

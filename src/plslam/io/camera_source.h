@@ -6,6 +6,7 @@
 #include <string>
 
 #include "plslam/core/types.h"
+#include "plslam/geometry/stereo_rectification.h"
 #include "plslam/io/live_capture.h"
 
 namespace plslam::io {
@@ -19,5 +20,9 @@ namespace plslam::io {
 // frames) can be tried and tested without a camera.
 std::unique_ptr<FrameSource> open_stereo_camera(const std::string& device, const std::string& right_device,
                                                      const StereoCalibration& calibration);
+
+// A source whose raw frames are rectified as they come (for a raw calibration, io/camchain_file.h).
+std::unique_ptr<FrameSource> rectify_frames(std::unique_ptr<FrameSource> raw,
+                                            const geometry::StereoRectification& rectification);
 
 }  // namespace plslam::io

@@ -109,6 +109,10 @@ std::unique_ptr<Dataset> open_dataset(const fs::path& given, const DatasetOption
   if (format == DatasetFormat::kEuroc) {
     return detail::open_euroc(mav0.empty() ? path : mav0, options);
   }
+  if (!options.calibration.empty()) {
+    throw InputError(options.calibration.string(), "--calib is for EuRoC folders, videos and cameras: a KITTI "
+                                                   "sequence comes rectified, with its calibration in calib.txt");
+  }
   return detail::open_kitti(path, options);
 }
 

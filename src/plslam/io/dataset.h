@@ -53,6 +53,9 @@ struct DatasetOptions {
   std::filesystem::path imu_csv, imu_calib;
   // The rectified field of view of inputs rectified on reading (geometry/stereo_rectification.h).
   double rectify_balance = 0.0;
+  // A raw calibration file (io/camchain_file.h) in place of an EuRoC folder's two sensor.yaml
+  // (--calib); KITTI, whose images come rectified, refuses it.
+  std::filesystem::path calibration;
 };
 
 // The raw cameras of an input that is rectified on reading, and what rectification kept of them.

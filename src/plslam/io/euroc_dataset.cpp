@@ -13,6 +13,7 @@
 
 #include "plslam/core/error.h"
 #include "plslam/io/dataset_impl.h"
+#include "plslam/io/calibration_file.h"
 #include "plslam/io/euroc_sensor.h"
 #include "plslam/io/image_loading.h"
 #include "plslam/io/imu_input.h"
@@ -20,14 +21,8 @@
 #include "plslam/io/trajectory_io.h"
 
 namespace plslam::io::detail {
-namespace {
 
 namespace fs = std::filesystem;
-
-struct ImageEntry {
-  std::int64_t ns = 0;
-  std::string file;
-};
 
 std::vector<ImageEntry> read_image_list(const fs::path& csv) {
   std::ifstream in = open_text_file(csv);
@@ -59,6 +54,8 @@ std::vector<ImageEntry> read_image_list(const fs::path& csv) {
   return entries;
 }
 
+namespace {
+
 class EurocDataset final : public Dataset {
  public:
   EurocDataset(const fs::path& mav0, const DatasetOptions& options) {
@@ -66,12 +63,18 @@ class EurocDataset final : public Dataset {
     const auto yaml0 = mav0 / "cam0" / "sensor.yaml";
     const auto yaml1 = mav0 / "cam1" / "sensor.yaml";
     cam0_ = read_euroc_camera_yaml(yaml0);
-    const auto cam1 = read_euroc_camera_yaml(yaml1);
-    if (cam0_.width != cam1.width || cam0_.height != cam1.height) {
-      throw InputError(yaml1.string(), fmt::format("resolution {}x{} differs from cam0's {}x{}", cam1.width,
-                                                   cam1.height, cam0_.width, cam0_.height));
+    if (!options.calibration.empty()) {
+      use_calibration_file(options.calibration, options.rectify_balance);
+    } else {
+      const auto cam1 = read_euroc_camera_yaml(yaml1);
+      if (cam0_.width != cam1.width || cam0_.height != cam1.height) {
+        throw InputError(yaml1.string(), fmt::format("resolution {}x{} differs from cam0's {}x{}", cam1.width,
+                                                     cam1.height, cam0_.width, cam0_.height));
+      }
+      // p_c1 = T_BS1^-1 * T_BS0 * p_c0: the pose of cam0 in cam1's frame, as stereoRectify wants.
+      compute_rectification({cam0_.lens(), cam1.lens(), cam1.T_BS.inverse() * cam0_.T_BS}, yaml1,
+                            options.rectify_balance);
     }
-    compute_rectification(cam1, yaml1, options.rectify_balance);
 
     const auto left = read_image_list(mav0 / "cam0" / "data.csv");
     const auto right = read_image_list(mav0 / "cam1" / "data.csv");
@@ -107,8 +110,8 @@ class EurocDataset final : public Dataset {
     f.blank = !f.problem.empty();
     for (const auto& [img, path] : {std::pair{&raw_left, &f.left_path}, std::pair{&raw_right, &f.right_path}}) {
       if (img->cols != cam0_.width || img->rows != cam0_.height) {
-        throw InputError(path->string(), fmt::format("image is {}x{} but sensor.yaml says {}x{}", img->cols,
-                                                     img->rows, cam0_.width, cam0_.height));
+        throw InputError(path->string(), fmt::format("image is {}x{} but {} says {}x{}", img->cols, img->rows,
+                                                     size_source_, cam0_.width, cam0_.height));
       }
     }
     cv::remap(raw_left, f.left, map_left_[0], map_left_[1], cv::INTER_LINEAR);
@@ -122,21 +125,39 @@ class EurocDataset final : public Dataset {
     std::string left, right;
   };
 
-  void compute_rectification(const EurocCameraSensor& cam1, const fs::path& yaml1, double balance) {
+  void compute_rectification(const geometry::RawStereoRig& rig, const fs::path& source, double balance) {
     RawRig raw;
-    raw.rig.left = cam0_.lens();
-    raw.rig.right = cam1.lens();
-    // p_c1 = T_BS1^-1 * T_BS0 * p_c0: the pose of cam0 in cam1's frame, as stereoRectify wants.
-    raw.rig.T_right_left = cam1.T_BS.inverse() * cam0_.T_BS;
-    const auto rect = geometry::rectify_stereo(raw.rig, balance, yaml1.string());
+    raw.rig = rig;
+    const auto rect = geometry::rectify_stereo(raw.rig, balance, source.string());
     calib_ = rect.calibration;
-    validate_calibration(calib_, yaml1);
+    validate_calibration(calib_, source);
     R_rect_sensor_ = rect.R_rect_left;
     map_left_ = rect.map_left;
     map_right_ = rect.map_right;
     raw.balance = balance;
     raw.coverage = rect.coverage;
     raw_rig_ = raw;
+  }
+
+  // The user's raw calibration in place of the two sensor.yaml: cam0's T_BS stays (it ties the
+  // ground truth and the IMU to the camera), the cameras and the pose between them are the file's.
+  void use_calibration_file(const fs::path& file, double balance) {
+    const UserCalibration user = read_user_calibration(file);
+    if (!user.raw) {
+      throw InputError(file.string(), "holds a rectified calibration, but EuRoC images are raw: --calib for a "
+                                      "dataset folder needs the raw cameras (cam0, cam1), as plslam calibrate "
+                                      "writes them");
+    }
+    cam0_.width = user.raw->left.width;
+    cam0_.height = user.raw->left.height;
+    cam0_.fu = user.raw->left.fx;
+    cam0_.fv = user.raw->left.fy;
+    cam0_.cu = user.raw->left.cx;
+    cam0_.cv = user.raw->left.cy;
+    cam0_.distortion_model = user.raw->left.model;
+    cam0_.distortion = user.raw->left.coeffs;
+    size_source_ = file.string();
+    compute_rectification(*user.raw, file, balance);
   }
 
   void pair_images(const std::vector<ImageEntry>& left, const std::vector<ImageEntry>& right) {
@@ -189,6 +210,7 @@ class EurocDataset final : public Dataset {
   }
 
   EurocCameraSensor cam0_;
+  std::string size_source_ = "sensor.yaml";  // where the image size comes from, for errors
   std::array<cv::Mat, 2> map_left_, map_right_;
   std::vector<Pair> pairs_;
 };

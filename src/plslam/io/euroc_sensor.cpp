@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "plslam/core/error.h"
+#include "plslam/io/atomic_file.h"
 #include "plslam/io/sensor_yaml.h"
 
 namespace plslam::io {
@@ -58,6 +59,32 @@ EurocCameraSensor parse_camera_yaml(const YAML::Node& root, const fs::path& path
 EurocCameraSensor read_euroc_camera_yaml(const fs::path& path) {
   const YAML::Node root = detail::load_sensor_yaml(path);
   return with_yaml_errors_as_input_errors(path, [&] { return parse_camera_yaml(root, path); });
+}
+
+void write_euroc_camera_yaml(const fs::path& path, const EurocCameraSensor& s, const std::string& comment) {
+  // Double-quoted, so that a colon or a '#' in the comment stays text.
+  std::string quoted = "\"";
+  for (const char c : comment) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c == '\n' ? ' ' : c;
+  }
+  quoted += '"';
+  write_file_atomically(path, [&](std::ostream& out) {
+    const Eigen::Matrix4d M = s.T_BS.matrix();
+    out << "%YAML:1.0\n# General sensor definitions.\nsensor_type: camera\n"
+        << "comment: " << quoted << "\n\n# Sensor extrinsics wrt. the body-frame.\nT_BS:\n  cols: 4\n  rows: 4\n  data: [";
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) out << fmt::format("{:.17g}", M(r, c)) << (r < 3 || c < 3 ? ", " : "");
+      out << (r < 3 ? "\n         " : "]\n");
+    }
+    out << "\n# Camera specific definitions.\n";
+    if (s.rate_hz > 0) out << fmt::format("rate_hz: {}\n", s.rate_hz);
+    out << fmt::format("resolution: [{}, {}]\ncamera_model: pinhole\n", s.width, s.height)
+        << fmt::format("intrinsics: [{:.17g}, {:.17g}, {:.17g}, {:.17g}] #fu, fv, cu, cv\n", s.fu, s.fv, s.cu, s.cv)
+        << fmt::format("distortion_model: {}\ndistortion_coefficients: [{:.17g}, {:.17g}, {:.17g}, {:.17g}]\n",
+                       geometry::to_string(s.distortion_model), s.distortion[0], s.distortion[1], s.distortion[2],
+                       s.distortion[3]);
+  });
 }
 
 Trajectory body_to_sensor(const Trajectory& body, const Eigen::Isometry3d& T_BS) {

@@ -4,6 +4,7 @@
 // the pose of the sensor in the body frame (p_body = T_BS * p_sensor).
 #include <array>
 #include <filesystem>
+#include <string>
 
 #include <Eigen/Geometry>
 
@@ -27,6 +28,11 @@ struct EurocCameraSensor {
 // Throws InputError naming the file on a missing file, malformed YAML, missing keys, wrong sizes,
 // NaNs or a T_BS that is not a rigid transform.
 EurocCameraSensor read_euroc_camera_yaml(const std::filesystem::path& path);
+
+// Writes a camera's sensor.yaml atomically, as the ASL/EuRoC layout has it, with `comment` in its
+// comment field; read back by read_euroc_camera_yaml it gives the same numbers.
+void write_euroc_camera_yaml(const std::filesystem::path& path, const EurocCameraSensor& sensor,
+                             const std::string& comment);
 
 // Reads only T_BS, for files such as a body-to-camera argument of `plslam eval`.
 Eigen::Isometry3d read_euroc_T_BS(const std::filesystem::path& path);

@@ -9,8 +9,8 @@
 
 namespace plslam::io::detail {
 
-YAML::Node load_sensor_yaml(const std::filesystem::path& path) {
-  std::ifstream in = open_text_file(path);
+YAML::Node load_sensor_yaml(const std::filesystem::path& path, const char* missing) {
+  std::ifstream in = open_text_file(path, missing);
   std::stringstream ss;
   std::string line;
   bool first = true;

@@ -15,7 +15,7 @@ namespace plslam::io::detail {
 // The file as a YAML mapping, with the "%YAML:1.0" directive ASL files start with (OpenCV's, not
 // valid YAML 1.2) blanked out. Throws InputError naming the file (and the line) when it is missing
 // or malformed.
-YAML::Node load_sensor_yaml(const std::filesystem::path& path);
+YAML::Node load_sensor_yaml(const std::filesystem::path& path, const char* missing = "file not found");
 
 // `expected` finite numbers from a YAML sequence; InputError naming `key` otherwise.
 std::vector<double> sensor_numbers(const YAML::Node& node, const char* key, std::size_t expected,

@@ -12,6 +12,7 @@
 // counted by decoding it once at opening.
 #include "plslam/io/video_dataset.h"
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <mutex>
@@ -70,7 +71,7 @@ class VideoDataset final : public Dataset {
  public:
   VideoDataset(const fs::path& video, const fs::path& calibration, const DatasetOptions& options) {
     root_ = video;
-    calib_ = read_calibration_file(calibration);
+    use_calibration(calibration, options.rectify_balance);
     std::error_code ec;
     if (!fs::exists(video, ec)) throw InputError(video.string(), "no such file");
     if (fs::is_directory(video, ec)) throw InputError(video.string(), "is a folder, expected a video file");
@@ -129,6 +130,13 @@ class VideoDataset final : public Dataset {
     f.timestamp = timestamps_[i];
     f.left_path = f.right_path = root_;
     split_side_by_side(frame, calib_.width, calib_.height, root_.string(), f.left, f.right);
+    if (raw_rig_) {  // a raw calibration: rectify here, as the EuRoC reader does
+      cv::Mat left, right;
+      cv::remap(f.left, left, map_left_[0], map_left_[1], cv::INTER_LINEAR);
+      cv::remap(f.right, right, map_right_[0], map_right_[1], cv::INTER_LINEAR);
+      f.left = left;
+      f.right = right;
+    }
     f.problem = blank_image_problem(f.left, root_);
     if (f.problem.empty()) f.problem = blank_image_problem(f.right, root_);
     if (next_ == total_ && capture_.grab()) {
@@ -139,6 +147,20 @@ class VideoDataset final : public Dataset {
   }
 
  private:
+  // The rectified form is used as it is; a raw (camchain) one is rectified with `balance`. Either
+  // way calib_ ends up the rectified pair, whose width and height are one raw image's.
+  void use_calibration(const fs::path& file, double balance) {
+    const UserCalibration user = read_user_calibration(file);
+    const InputRectification in = rectify_user_calibration(user, balance, file);
+    calib_ = in.calibration;
+    if (!in.rectification) return;
+    validate_calibration(calib_, file);
+    R_rect_sensor_ = in.rectification->R_rect_left;
+    map_left_ = in.rectification->map_left;
+    map_right_ = in.rectification->map_right;
+    raw_rig_ = RawRig{*user.raw, balance, in.rectification->coverage};
+  }
+
   // Opens the file again at its first frame.
   void reopen() const {
     capture_.release();
@@ -188,18 +210,22 @@ class VideoDataset final : public Dataset {
     gt_path_ = path;
   }
 
-  // --imu and --imu-calib: the body frame of the IMU's T_BS is the rectified left camera, and the
-  // samples' nanoseconds are on the frames' clock (0 at the video's first frame).
+  // --imu and --imu-calib: the body frame of the IMU's T_BS is the left camera (the raw one for a
+  // raw calibration), and the samples' nanoseconds are on the frames' clock (0 at the video's
+  // first frame).
   void load_imu(const DatasetOptions& options) {
     if (options.imu_csv.empty() != options.imu_calib.empty()) {
       throw InputError(root_.string(), "--imu and --imu-calib go together");
     }
     if (options.imu_csv.empty()) return;
     imu_path_ = options.imu_csv;
-    imu_ = read_imu(options.imu_csv, options.imu_calib, Eigen::Isometry3d::Identity());
+    Eigen::Isometry3d T_sensor_rect = Eigen::Isometry3d::Identity();
+    T_sensor_rect.linear() = R_rect_sensor_.transpose();  // identity for a rectified calibration
+    imu_ = read_imu(options.imu_csv, options.imu_calib, T_sensor_rect);
     keep_imu_span(*imu_, timestamps_.front(), timestamps_.back(), options.imu_csv);
   }
 
+  std::array<cv::Mat, 2> map_left_, map_right_;  // for a raw calibration
   double fps_ = 0;
   std::size_t total_ = 0;  // frames the container counts
   std::size_t start_ = 0;  // first selected frame
