@@ -100,3 +100,9 @@ plslam_test(RunImuInit.RenderedCarIsInitialisedNearTheTruthOrNotAtAll COST 3 LAB
 # sanitizers in FrameStream.BlankFramesArePassedOnOnlyWhenAsked, the stereo-inertial tracking in
 # the office loop of LoopClosingConcurrent (its render has an IMU).
 plslam_test(RunImuBlackOut.ThreeSecondsOfBlackFramesAreCarriedByTheImuAndRejoinTheMap COST 8 LABELS sanitizer_skip)
+# Issue 54's chain at a smaller size, a rendered board to a calibration to a fisheye office run
+# (25 s in Release): calibrate's detection and solve run under the sanitizers in
+# CalibrateCli.BadInput* and StereoCalibration.UnsynchronisedPairsAreRefused.
+plslam_test(CalibrateCli.BoardToCalibrationToMap COST 25 LABELS sanitizer_skip)
+# Three calibrations of 60 rendered views (15 s in Release; the same solve as above).
+plslam_suite(Models/CalibrationAccuracy COST 15 LABELS sanitizer_skip)
