@@ -100,6 +100,10 @@ plslam_test(RunImuInit.RenderedCarIsInitialisedNearTheTruthOrNotAtAll COST 3 LAB
 # sanitizers in FrameStream.BlankFramesArePassedOnOnlyWhenAsked, the stereo-inertial tracking in
 # the office loop of LoopClosingConcurrent (its render has an IMU).
 plslam_test(RunImuBlackOut.ThreeSecondsOfBlackFramesAreCarriedByTheImuAndRejoinTheMap COST 8 LABELS sanitizer_skip)
+# A 480-frame drone render and a 345-frame run (30 s in Release): the same tracking paths run under the
+# sanitizers in the office loop of LoopClosingConcurrent; the new view's keyframe is made as a
+# tracked frame's is (create_keyframe) with the points a new map's first keyframe gets.
+plslam_test(RunImuBlackOut.AViewTheMapLacksAfterABlackOutIsMappedFromTheImu COST 30 LABELS sanitizer_skip)
 # Issue 54's chain at a smaller size, a rendered board to a calibration to a fisheye office run
 # (25 s in Release): calibrate's detection and solve run under the sanitizers in
 # CalibrateCli.BadInput* and StereoCalibration.UnsynchronisedPairsAreRefused.

@@ -32,6 +32,22 @@ nlohmann::json run_imu(const fs::path& seq, const fs::path& out, const std::stri
   return nlohmann::json::parse(in)["imu"];
 }
 
+// Frames first .. first + count - 1 of both cameras of a render of `frames` frames turn black.
+void black_out(const fs::path& seq, std::size_t frames, int first, int count) {
+  for (const char* cam : {"cam0", "cam1"}) {
+    std::vector<fs::path> images;
+    for (const auto& e : fs::directory_iterator(seq / "mav0" / cam / "data")) images.push_back(e.path());
+    std::sort(images.begin(), images.end(), [](const fs::path& a, const fs::path& b) {
+      return std::stoll(a.stem().string()) < std::stoll(b.stem().string());
+    });
+    ASSERT_EQ(images.size(), frames);
+    const cv::Mat image = cv::imread(images[0].string(), cv::IMREAD_UNCHANGED);
+    for (int i = first; i < first + count; ++i) {
+      ASSERT_TRUE(cv::imwrite(images[static_cast<std::size_t>(i)].string(), cv::Mat::zeros(image.size(), image.type())));
+    }
+  }
+}
+
 // Columns 11-13 of state_groundtruth_estimate0 (the gyro bias) in the row nearest `t`.
 Eigen::Vector3d true_gyro_bias(const fs::path& mav0, double t) {
   Eigen::Vector3d best = Eigen::Vector3d::Constant(NAN);
@@ -205,18 +221,7 @@ TEST(RunImuBlackOut, ThreeSecondsOfBlackFramesAreCarriedByTheImuAndRejoinTheMap)
                                    "\" --scene office --frames 240 --seed 6 --motion handheld --imu-noise euroc");
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   constexpr int kFirst = 150, kBlack = 60;  // 7.5 s in (initialised at ~4.5 s), 3 s at 20 Hz
-  for (const char* cam : {"cam0", "cam1"}) {
-    std::vector<fs::path> images;
-    for (const auto& e : fs::directory_iterator(seq / "mav0" / cam / "data")) images.push_back(e.path());
-    std::sort(images.begin(), images.end(), [](const fs::path& a, const fs::path& b) {
-      return std::stoll(a.stem().string()) < std::stoll(b.stem().string());
-    });
-    ASSERT_EQ(images.size(), 240u);
-    const cv::Mat first = cv::imread(images[0].string(), cv::IMREAD_UNCHANGED);
-    for (int i = kFirst; i < kFirst + kBlack; ++i) {
-      ASSERT_TRUE(cv::imwrite(images[static_cast<std::size_t>(i)].string(), cv::Mat::zeros(first.size(), first.type())));
-    }
-  }
+  black_out(seq, 240, kFirst, kBlack);
   const auto imu = run_imu(seq, tmp.path() / "vi");
   ASSERT_TRUE(imu.is_object());
   EXPECT_EQ(imu["slam"]["mode"], "stereo-inertial");
@@ -256,6 +261,39 @@ TEST(RunImuBlackOut, ThreeSecondsOfBlackFramesAreCarriedByTheImuAndRejoinTheMap)
   EXPECT_EQ(vo["skipped_frames"], kBlack);
   EXPECT_EQ(vo["frame_states"]["inertial"], 0);
   EXPECT_GE(vo["lost_events"].get<int>(), 1);  // stereo alone loses the camera there (a new segment)
+}
+
+// A black-out that ends facing what the map has not seen (the drone turned during it): vision
+// finds nothing to place the frame by, and the IMU's pose starts mapping the view, in the same map
+// (without imu.map_new_views the camera is lost there for 20 frames and a new map segment starts:
+// measured, ATE 0.0054 m over the tracked frames). Measured: 0.0078 m, without the black-out 0.0057.
+TEST(RunImuBlackOut, AViewTheMapLacksAfterABlackOutIsMappedFromTheImu) {
+  test::TempDir tmp;
+  const auto seq = tmp.path() / "office";
+  const auto synth = test::run_cli("synth --out \"" + seq.string() +
+                                   "\" --scene office --frames 480 --loop --seed 8 --motion drone --imu-noise euroc");
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  constexpr int kFirst = 300, kBlack = 20, kFrames = 345;  // 1 s; the run stops 1.25 s after it
+  black_out(seq, 480, kFirst, kBlack);
+  const auto imu = run_imu(seq, tmp.path() / "vi", " --max-frames " + std::to_string(kFrames));
+  ASSERT_TRUE(imu.is_object());
+  EXPECT_EQ(imu["slam"]["new_views_from_imu"], 1) << imu["slam"].dump();
+  const auto stats = nlohmann::json::parse(test::read_file(tmp.path() / "vi" / "stats.json"));
+  EXPECT_EQ(stats["lost_events"], 0);
+  EXPECT_EQ(stats["relocalizations"]["count"], 0);
+  EXPECT_EQ(stats["new_map_segments"]["count"], 0) << stats["new_map_segments"].dump();
+  EXPECT_EQ(stats["frame_states"]["inertial"], kBlack + 1) << stats["frame_states"].dump();
+  EXPECT_EQ(stats["tracked_frames"], kFrames);
+  EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.012);
+  const auto log = eval::read_frame_log(tmp.path() / "vi" / "frames.csv");
+  const auto column = [&](const char* name) {
+    return static_cast<std::size_t>(std::find(log.header.begin(), log.header.end(), name) - log.header.begin());
+  };
+  ASSERT_EQ(log.rows.size(), static_cast<std::size_t>(kFrames));
+  const auto& first_after = log.rows[kFirst + kBlack];
+  EXPECT_EQ(first_after[column("state")], "inertial");
+  EXPECT_EQ(first_after[column("keyframe_reason")], "new-view");
+  for (int i = kFirst + kBlack + 1; i < kFrames; ++i) EXPECT_EQ(log.rows[i][column("state")], "tracked") << "frame " << i;
 }
 
 }  // namespace

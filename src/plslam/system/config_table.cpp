@@ -389,6 +389,11 @@ std::vector<ConfigKey> make_table() {
     field("imu", "max_inertial_s", [](auto& o) -> auto& { return o.tracker.imu.max_inertial_s; },
           "frames vision cannot track take the IMU's pose for at most this long, then the camera is lost",
           at_least(0)),
+    field("imu", "map_new_views", [](auto& o) -> auto& { return o.tracker.imu.map_new_views; },
+          "a textured frame vision cannot place, within max_inertial_s, facing a view the map lacks: a keyframe at "
+          "the IMU's pose maps it (false: the camera is lost)"),
+    field("imu", "new_view_max_visible_points", [](auto& o) -> auto& { return o.tracker.imu.new_view_max_visible_points; },
+          "a view is new if fewer map points than this are visible from the IMU's pose", at_least(1)),
     field("imu", "refine_after_s", [](auto& o) -> auto& { return o.imu_refine_after_s; },
           "input seconds after the turn to stereo-inertial at which a global BA with the IMU factors refines gravity, "
           "velocities and biases over the whole map (0: not; needs loop closing)", at_least(0)),

@@ -298,7 +298,8 @@ nlohmann::json System::imu_report() const {
   const bool inertial = tracker_->imu_on();
   nlohmann::json slam = {{"mode", inertial ? "stereo-inertial" : "stereo"},
                          {"imu_tracked_frames", tracker_->imu_tracked_frames()},
-                         {"inertial_frames", tracker_->inertial_frames()}};
+                         {"inertial_frames", tracker_->inertial_frames()},
+                         {"new_views_from_imu", tracker_->new_views_from_imu()}};
   if (gravity_alignment_ && inertial) slam["from_frame"] = gravity_alignment_->from_frame;
   if (loaded_map_imu_ && inertial) slam["from_frame"] = loaded_map_imu_->from_frame;
   if (const auto bias = final_imu_bias()) {

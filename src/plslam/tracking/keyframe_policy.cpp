@@ -31,6 +31,7 @@ const char* to_string(KeyframeReason r) {
     case KeyframeReason::kMaxFrames: return "max-frames";
     case KeyframeReason::kVelocity: return "velocity";
     case KeyframeReason::kImuInterval: return "imu-interval";
+    case KeyframeReason::kNewView: return "new-view";
   }
   return "?";
 }

@@ -68,7 +68,7 @@ struct KeyframeInputs {
 };
 
 // kImuInterval: tracking with the IMU keeps keyframes close in time (ImuTrackingOptions).
-enum class KeyframeReason { kNone, kInlierRatio, kCloseDepth, kMaxFrames, kVelocity, kImuInterval };
+enum class KeyframeReason { kNone, kInlierRatio, kCloseDepth, kMaxFrames, kVelocity, kImuInterval, kNewView };
 const char* to_string(KeyframeReason r);
 
 struct KeyframeDecision {

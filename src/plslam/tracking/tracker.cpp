@@ -200,6 +200,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   prior_.reset();
   if (state_ == TrackingState::kOk) prior_ = imu_prior(f.data->timestamp);
   bool inertial = false;
+  bool new_view = false;  // inertial, and a keyframe whose new points the next frame searches
 
   bool ok = false;
   if (state_ == TrackingState::kNotInitialized) {
@@ -294,6 +295,10 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
     } else if (!recovery_ && carry_by_imu(f)) {
       ok = true;
       inertial = true;
+    } else if (!recovery_ && map_new_view_from_imu(f, result)) {
+      ok = true;
+      inertial = true;
+      new_view = true;
     } else {
       recovery_.reset();
       prior_.reset();
@@ -347,7 +352,7 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   if (ok) result.pose_covariance = f.pose_covariance;
   result.tracked = rec.trusted();
   // An inertial frame matched nothing: the next frame searches the last one vision tracked.
-  if (!inertial) last_ = std::move(f);
+  if (!inertial || new_view) last_ = std::move(f);
   return result;
 }
 

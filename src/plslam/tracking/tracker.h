@@ -99,6 +99,14 @@ struct ImuTrackingOptions {
   // prediction, state `inertial`, for at most this long after the last frame vision tracked;
   // then the camera is lost, as without an IMU.
   double max_inertial_s = 4.0;
+  // A textured frame that vision cannot place in the map within max_inertial_s of the last frame
+  // it tracked, where the map shows little from the IMU's pose (a black-out or a fast turn ended
+  // facing what the map has not seen): a keyframe at the IMU's pose starts mapping that view, in
+  // the same map and IMU chain, state `inertial`. Where the map shows at least
+  // new_view_max_visible_points there, the frame is lost instead: the view is not new, so the
+  // IMU's pose or the images are wrong.
+  bool map_new_views = true;
+  int new_view_max_visible_points = 60;
 };
 
 struct TrackerOptions {
@@ -248,6 +256,8 @@ class Tracker {
   // Frames tracked with the IMU's residual, and frames the IMU carried alone (state inertial).
   int imu_tracked_frames() const { return imu_tracked_frames_; }
   int inertial_frames() const { return inertial_frames_; }
+  // Of those, the keyframes that started mapping a view the map lacked (map_new_views).
+  int new_views_from_imu() const { return new_views_from_imu_; }
   // Whether a frame at time t that vision cannot use (a blank image) would now take the IMU's pose
   // (state inertial): tracking is on, with the IMU's prediction, within max_inertial_s of the last
   // frame vision tracked. plslam run passes its blank frames to tracking only then.
@@ -327,6 +337,16 @@ class Tracker {
                                                const optim::PoseOnlyOptions& options);
   // A frame vision could not track, within max_inertial_s of the last it did: the IMU's pose.
   bool carry_by_imu(Frame& f);
+  // ImuTrackingOptions::map_new_views: a keyframe at the IMU's pose for a view the map lacks.
+  bool map_new_view_from_imu(Frame& f, TrackResult& result);
+  // The map points and lines of the keyframes nearest f's pose (the IMU's prediction) that look
+  // within 45 deg of its direction, at most local_map_covisibles of them.
+  struct NearPrediction {
+    std::vector<map::MapPoint*> points;
+    std::vector<map::MapLine*> lines;
+    std::size_t keyframes = 0;
+  };
+  NearPrediction landmarks_near_imu_prediction(const Frame& f) const;
   // Whether t is at most max_inertial_s after the last frame vision tracked.
   bool within_inertial_window(double t) const;
   // After a gap the last frame's matches and the reference keyframe may be out of view: the map
@@ -446,6 +466,7 @@ class Tracker {
   long own_keyframes_from_ = 0;
   int imu_tracked_frames_ = 0;
   int inertial_frames_ = 0;
+  int new_views_from_imu_ = 0;
 };
 
 }  // namespace plslam::tracking

@@ -135,11 +135,7 @@ optim::PoseOnlyResult Tracker::optimize_pose_inertial(Frame& f, const std::vecto
   return std::move(r.visual);
 }
 
-bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
-  if (!prior_) return false;
-  const auto t0 = std::chrono::steady_clock::now();
-  f.T_cw = prior_->T_cw;
-  f.clear_matches();
+Tracker::NearPrediction Tracker::landmarks_near_imu_prediction(const Frame& f) const {
   // Keyframes near the predicted camera, looking within 45 deg of its direction, nearest first.
   const Eigen::Vector3d centre = f.camera_center();
   const Eigen::Vector3d axis = f.T_cw.rotation().row(2).transpose();
@@ -153,8 +149,9 @@ bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
   const std::size_t n = std::min(near.size(), static_cast<std::size_t>(options_.local_map_covisibles));
   std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end(),
                     [](const auto& a, const auto& b) { return a.first < b.first || (a.first == b.first && a.second->id() < b.second->id()); });
-  std::vector<map::MapPoint*> points;
-  std::vector<map::MapLine*> lines;
+  NearPrediction near_map;
+  auto& points = near_map.points;
+  auto& lines = near_map.lines;
   core::PointerSet seen_p, seen_l;
   seen_p.assign(f.points, 0);
   seen_l.assign(f.lines, 0);
@@ -167,6 +164,16 @@ bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
       if (ml && !ml->is_bad() && seen_l.insert(ml)) lines.push_back(ml);
     }
   }
+  near_map.keyframes = n;
+  return near_map;
+}
+
+bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
+  if (!prior_) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  f.T_cw = prior_->T_cw;
+  f.clear_matches();
+  const auto [points, lines, n] = landmarks_near_imu_prediction(f);
   int found = search_points_in_local_map(f, points, options_.motion_retry_scale * options_.local_map_radius, options_.search);
   if (options_.lines) found += search_lines(f, lines, options_.motion_retry_scale * options_.line_radius, options_.search);
   int inliers = 0;
@@ -175,6 +182,49 @@ bool Tracker::track_from_imu_prediction(Frame& f, TrackStageTimes& t) {
   t.track_motion_ms += ms_since(t0);
   spdlog::debug("frame {}: {} matches in {} keyframes near the IMU's prediction, {} inliers", f.id(), found, n, inliers);
   return inliers >= options_.min_pose_inliers;
+}
+
+bool Tracker::map_new_view_from_imu(Frame& f, TrackResult& result) {
+  const auto& o = options_.imu;
+  if (!prior_ || !o.map_new_views || options_.localization_only) return false;
+  if (!within_inertial_window(f.data->timestamp) || !can_start_map(f)) return false;
+  f.clear_matches();
+  f.T_cw = prior_->T_cw;
+  const auto near_map = landmarks_near_imu_prediction(f);
+  const int visible = count_visible_points(f, near_map.points);
+  const double since_s = f.data->timestamp - *last_visual_t_;
+  if (visible >= o.new_view_max_visible_points) {
+    spdlog::debug("frame {}: {} map points visible from the IMU's pose, none placed it: not a new view", f.id(), visible);
+    return false;
+  }
+  f.imu = Frame::Imu{prior_->predicted.v, prior_->predicted.bias};
+  f.pose_covariance.setZero();
+  f.reference = reference_;
+  map::KeyFrame* kf = create_keyframe(f);
+  // Every stereo point and line, as a map's first keyframe has: the next frames track from them.
+  const auto& d = *f.data;
+  for (std::size_t i = 0; i < d.keypoints.size(); ++i) {
+    if (d.depth[i] > 0 && !f.points[i]) create_stereo_point(f, kf, i);
+  }
+  if (options_.lines) {
+    for (std::size_t j = 0; j < d.lines.size(); ++j) {
+      if (d.lines[j].stereo && !f.lines[j]) create_stereo_line(f, kf, j);
+    }
+  }
+  local_keyframes_ = {kf};
+  KeyframeInputs in;
+  in.frame_id = f.id();
+  in.timestamp = d.timestamp;
+  in.position = f.camera_center();
+  policy_.keyframe_inserted(in);
+  result.keyframe = true;
+  result.decision.insert = true;
+  result.decision.reason = KeyframeReason::kNewView;
+  ++inertial_frames_;
+  ++new_views_from_imu_;
+  spdlog::info("frame {}: a view the map lacks ({} map points visible from the IMU's pose), {:.2f} s after the last "
+               "frame vision tracked: mapped from the IMU's pose", f.id(), visible, since_s);
+  return true;
 }
 
 bool Tracker::within_inertial_window(double t) const {
