@@ -5,7 +5,6 @@
 #include <cmath>
 #include <fstream>
 #include <mutex>
-
 #include <optional>
 
 #include <fmt/format.h>
@@ -17,6 +16,7 @@
 #include "plslam/core/error.h"
 #include "plslam/core/worker_pool.h"
 #include "plslam/io/calibration_file.h"
+#include "plslam/io/euroc_sensor.h"
 #include "plslam/io/trajectory_io.h"
 #include "plslam/io/video_dataset.h"
 
@@ -78,24 +78,21 @@ std::string matrix_yaml(const Eigen::Isometry3d& T) {
 }
 
 void write_sensor_yaml(const fs::path& p, const Sequence& seq, const Eigen::Isometry3d& T_BS, int cam) {
-  const auto& pr = seq.options().preset;
   const geometry::LensCamera l = seq.lens(cam);
   const bool ideal = seq.options().camera == CameraKind::kPinhole;
-  auto out = open_out(p);
-  out << "%YAML:1.0\n# General sensor definitions.\nsensor_type: camera\n"
-      << "comment: plslam synth cam" << cam << (ideal ? " (ideal rectified pinhole)" : fmt::format(" ({} lens)", to_string(seq.options().camera)))
-      << "\n\n"
-      << "# Sensor extrinsics wrt. the body-frame.\nT_BS:\n" << matrix_yaml(T_BS) << "\n"
-      << "# Camera specific definitions.\n"
-      << fmt::format("rate_hz: {}\n", pr.fps) << fmt::format("resolution: [{}, {}]\n", l.width, l.height)
-      << "camera_model: pinhole\n"
-      << fmt::format("intrinsics: [{:.17g}, {:.17g}, {:.17g}, {:.17g}] #fu, fv, cu, cv\n", l.fx, l.fy, l.cx, l.cy);
-  if (ideal) {
-    out << "distortion_model: radial-tangential\ndistortion_coefficients: [0.0, 0.0, 0.0, 0.0]\n";
-  } else {
-    out << fmt::format("distortion_model: {}\ndistortion_coefficients: [{:.17g}, {:.17g}, {:.17g}, {:.17g}]\n",
-                       geometry::to_string(l.model), l.coeffs[0], l.coeffs[1], l.coeffs[2], l.coeffs[3]);
-  }
+  io::EurocCameraSensor s;
+  s.T_BS = T_BS;
+  s.width = l.width;
+  s.height = l.height;
+  s.fu = l.fx;
+  s.fv = l.fy;
+  s.cu = l.cx;
+  s.cv = l.cy;
+  s.distortion_model = ideal ? geometry::LensModel::kRadialTangential : l.model;
+  if (!ideal) s.distortion = l.coeffs;
+  s.rate_hz = seq.options().preset.fps;
+  io::write_euroc_camera_yaml(p, s, fmt::format("plslam synth cam{} ({})", cam, ideal ? "ideal rectified pinhole"
+                                                : fmt::format("{} lens", to_string(seq.options().camera))));
 }
 
 void write_imu(const SyntheticImu& imu, const fs::path& dir) {
