@@ -10,6 +10,7 @@ install(DIRECTORY ${CMAKE_SOURCE_DIR}/src/plslam DESTINATION ${CMAKE_INSTALL_INC
   FILES_MATCHING PATTERN "*.h" PATTERN "*.inc")
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/config/ DESTINATION ${CMAKE_INSTALL_DATADIR}/plslam/config)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/data/vocabulary/ DESTINATION ${CMAKE_INSTALL_DATADIR}/plslam/vocabulary)
+install(DIRECTORY ${CMAKE_SOURCE_DIR}/data/published/ DESTINATION ${CMAKE_INSTALL_DATADIR}/plslam/published)
 # The browser viewer's page with its three.js files, as the build copied them (cmake/WebAssets.cmake).
 install(DIRECTORY ${CMAKE_BINARY_DIR}/web/ DESTINATION ${CMAKE_INSTALL_DATADIR}/plslam/web)
 install(EXPORT plslamTargets NAMESPACE plslam:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/plslam)

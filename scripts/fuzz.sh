@@ -5,7 +5,7 @@
 #   scripts/fuzz.sh [--minutes N | --seconds S] [target...]   default: 5 minutes each, every target
 #
 # Targets (tests/fuzz/targets): config trajectory euroc_sensor euroc_data_csv euroc_groundtruth
-# kitti_calib kitti_times frame_log image vocabulary bench_configs map_file calibration_file
+# kitti_calib kitti_times frame_log image vocabulary bench_configs bench_plan published_results map_file calibration_file
 # run_folder imu_csv imu_sensor. Each starts from tests/fuzz/corpus/<target>/ (the
 # checked-in seeds) and keeps what it learns in build-fuzz/corpus/<target>/; crashes are written
 # to build-fuzz/crashes/<target>/. A crash input belongs in tests/fuzz/corpus/<target>/ once the
@@ -29,7 +29,7 @@ case "$seconds" in
   ''|*[!0-9]*|0) echo "fuzz.sh: the time per target must be a positive whole number of seconds" >&2; exit 2 ;;
 esac
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(config trajectory euroc_sensor euroc_data_csv euroc_groundtruth kitti_calib kitti_times frame_log image vocabulary bench_configs map_file calibration_file run_folder imu_csv imu_sensor)
+  targets=(config trajectory euroc_sensor euroc_data_csv euroc_groundtruth kitti_calib kitti_times frame_log image vocabulary bench_configs bench_plan published_results map_file calibration_file run_folder imu_csv imu_sensor)
 fi
 
 BUILD_DIR=${BUILD_DIR:-build-fuzz}

@@ -11,7 +11,7 @@ PACKAGES=(
   nlohmann-json3-dev libcpp-httplib-dev libdeflate-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   pybind11-dev python3-dev python3-numpy python3-pytest dpkg-dev
-  chromium
+  chromium parallel
 )
 # Node.js and npm install the viewer's three.js (web/package-lock.json). A machine may have them
 # from elsewhere (NodeSource's nodejs holds npm and conflicts with Debian's npm package): Debian's

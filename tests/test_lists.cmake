@@ -23,6 +23,10 @@ plslam_test(RunSignals.StopAtAFrameBoundaryAndWriteEverything COST 60)
 # 4 default runs compared byte for byte (57 s under ASan); the bench's runs and report run there in
 # the SIGTERM test.
 plslam_test(BenchSlamCli.DefaultRunsEqualASeparateRunAndAnAnchorIsARow COST 57 LABELS sanitizer_skip)
+# 5 default runs of a 40-frame render, 2 through GNU parallel (9 s); the plan's lines, the Slurm
+# script, the suites and the published figures run under the sanitizers in BenchPlan, DatasetSuites
+# and PublishedResults.
+plslam_test(BenchSlamCli.APlanRunThroughGnuParallelReportsAsTheBenchItselfDoes COST 10 LABELS sanitizer_skip)
 # For ThreadSanitizer's eyes (the default mode's threads while relocalizing; 103 s there): under ASan
 # (104 s) the relocalization code runs in Relocalization.KeepsFailing* and WithoutPlaceRecognition*.
 plslam_test(RelocalizationConcurrent.KidnappedKittiCameraIsFoundAgainWhileLocalMappingRuns COST 55 LABELS asan_skip)

@@ -22,6 +22,11 @@ struct BenchSlamArgs {
   ModeArgs mode;
   int table1_frames = 20;
   bool json = false;
+  // Standard suites by their official folder names (bench/dataset_suites.h).
+  std::string euroc_root, kitti_root, tumvi_root;
+  std::string plan;                      // write the matrix as shell commands instead of running it
+  std::vector<std::string> report_from;  // build the report from these folders' runs
+  bool resume = false;                   // skip the runs already complete
 };
 
 // Exit code when some runs failed (the report is still written and marks them).

@@ -211,7 +211,7 @@ TEST(SlamBenchScoring, ARunWithoutOutputsSaysWhyAndScoresNothing) {
 }
 
 TEST(SlamBenchSummary, MediansMinMaxAndRatiosUseSuccessfulRunsOnly) {
-  const std::vector<BenchDataset> datasets = {{"d", "/d"}};
+  const std::vector<BenchDataset> datasets = {{"d", "/d", {}, {}}};
   const auto configs = select_slam_configurations("full,no-lines,no-loop-closing", builtin_slam_configurations());
   const auto rows = bench_rows(configs, "anchor");
   json results = json::array();
@@ -258,7 +258,7 @@ TEST(SlamBenchSummary, MediansMinMaxAndRatiosUseSuccessfulRunsOnly) {
 
 // The stereo-inertial row against the stereo one: ratios of the medians, and a line in the report.
 TEST(SlamBenchSummary, StereoInertialIsComparedWithStereo) {
-  const std::vector<BenchDataset> datasets = {{"d", "/d"}};
+  const std::vector<BenchDataset> datasets = {{"d", "/d", {}, {}}};
   const auto rows = bench_rows(select_slam_configurations("stereo-inertial,stereo", builtin_slam_configurations()), "");
   json results = json::array();
   auto add = [&](const std::string& row, int run, double ate, double ms, double imu) {

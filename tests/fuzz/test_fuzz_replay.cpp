@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "fuzz/targets/fuzz_bench_configs.cpp"
+#include "fuzz/targets/fuzz_bench_plan.cpp"
 #include "fuzz/targets/fuzz_calibration_file.cpp"
 #include "fuzz/targets/fuzz_config.cpp"
 #include "fuzz/targets/fuzz_datasets.cpp"
@@ -45,6 +46,8 @@ const Target kTargets[] = {
     {"map_file", fuzz_map_file},
     {"vocabulary", fuzz_vocabulary},
     {"bench_configs", fuzz_bench_configs},
+    {"bench_plan", fuzz_bench_plan},
+    {"published_results", fuzz_published_results},
     {"calibration_file", fuzz_calibration_file},
     {"run_folder", fuzz_run_folder},
     {"imu_csv", fuzz_imu_csv},

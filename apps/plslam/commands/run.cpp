@@ -15,6 +15,7 @@
 #include "stop_signals.h"
 #include "commands/dataset_options.h"
 #include "commands/mode_options.h"
+#include "plslam/core/build_id.h"
 #include "plslam/core/error.h"
 #include "plslam/core/stopwatch.h"
 #include "plslam/core/version.h"
@@ -50,8 +51,11 @@ constexpr int kExitNotUsable = 3;
 
 
 // Marks a run stopped by a signal (README: stats.json); "complete" already says it did not finish.
+// Also which build ran where: `bench slam --report-from` checks that collected runs share a build
+// and says when their timings come from different hosts.
 nlohmann::json with_interruption(nlohmann::json stats) {
   stats["interrupted_by"] = app::stop_requested() ? nlohmann::json(app::stop_signal_name()) : nlohmann::json(nullptr);
+  stats["build"] = {{"version", kVersion}, {"build_id", build_id()}, {"host", host_name()}};
   return stats;
 }
 

@@ -11,6 +11,7 @@
 #include "plslam/core/error.h"
 #include "plslam/core/sample_stats.h"
 #include "plslam/eval/evaluate.h"
+#include "plslam/eval/kitti_metric.h"
 #include "plslam/eval/rpe.h"
 #include "plslam/eval/statistics.h"
 #include "plslam/io/trajectory_io.h"
@@ -60,7 +61,7 @@ std::vector<BenchDataset> name_datasets(const std::vector<fs::path>& paths, cons
     std::string unique = name;
     for (int i = 2; used.count(unique); ++i) unique = fmt::format("{}-{}", name, i);
     used.insert(unique);
-    out.push_back({unique, p});
+    out.push_back({unique, p, {}, {}});
   }
   return out;
 }
@@ -76,6 +77,8 @@ const std::vector<MetricInfo>& bench_metrics() {
       {"rpe_frame_rot_deg", "RPE 1 frame deg", 3},
       {"rpe_1m_trans_m", "RPE 1 m m", 4},
       {"rpe_1m_rot_deg", "RPE 1 m deg", 3},
+      {"kitti_t_rel_percent", "KITTI t_rel %", 2},
+      {"kitti_r_rel_deg_per_100m", "KITTI r_rel deg/100 m", 2},
       {"tracked_share", "tracked %", 3},
       {"imu_share", "IMU %", 3},
       {"lost_events", "lost", 0},
@@ -90,9 +93,7 @@ const std::vector<MetricInfo>& bench_metrics() {
   return metrics;
 }
 
-namespace {
-
-json read_json(const fs::path& p) {
+json read_json_file(const fs::path& p) {
   std::ifstream in(p);
   if (!in) throw InputError(p.string(), "missing");
   try {
@@ -101,6 +102,8 @@ json read_json(const fs::path& p) {
     throw InputError(p.string(), std::string("not JSON: ") + e.what());
   }
 }
+
+namespace {
 
 json number_at(const json& j, std::initializer_list<const char*> path) {
   const json* cur = &j;
@@ -116,6 +119,26 @@ double ratio(const json& a, const json& b) {
   return a.get<double>() / b.get<double>();
 }
 
+// The KITTI devkit's t_rel and r_rel on trajectory.kitti (one pose per input frame, the last one
+// held where tracking was lost, as the devkit expects), paired with the ground truth by index.
+// Null where the run wrote no such file or the path is shorter than the devkit's 100 m.
+void measure_kitti_devkit(const Trajectory& gt, const fs::path& folder, json& m) {
+  const fs::path file = folder / "trajectory.kitti";
+  if (!fs::exists(file)) return;
+  try {
+    const auto est = io::read_trajectory(file, io::TrajectoryFormat::kKitti);
+    if (est.size() != gt.size()) {
+      m["kitti_error"] = fmt::format("{}: {} poses for {} ground-truth frames", file.string(), est.size(), gt.size());
+      return;
+    }
+    const auto k = eval::kitti_odometry_metric(gt, est);
+    m["kitti_t_rel_percent"] = k.t_rel_percent;
+    m["kitti_r_rel_deg_per_100m"] = k.r_rel_deg_per_100m;
+  } catch (const InputError&) {
+    // Shorter than one 100 m segment: no devkit figure.
+  }
+}
+
 }  // namespace
 
 json measure_run(const io::Dataset& dataset, const fs::path& folder, bool anchor) {
@@ -123,7 +146,7 @@ json measure_run(const io::Dataset& dataset, const fs::path& folder, bool anchor
   for (const auto& k : bench_metrics()) m[k.key] = nullptr;
   json stats;
   try {
-    stats = read_json(folder / "stats.json");
+    stats = read_json_file(folder / "stats.json");
   } catch (const InputError& e) {
     m["error"] = e.what();
     return m;
@@ -178,6 +201,7 @@ json measure_run(const io::Dataset& dataset, const fs::path& folder, bool anchor
     } catch (const InputError&) {
       // A path shorter than 1 m has no 1 m pair: the metric stays null.
     }
+    if (dataset.format() == io::DatasetFormat::kKitti) measure_kitti_devkit(*dataset.ground_truth(), folder, m);
   } catch (const InputError& e) {
     m["error"] = e.what();
   }
@@ -268,11 +292,11 @@ std::string ratio_cell(const json& s, const char* which, const char* key) {
 using Column = std::pair<std::string, std::function<std::string(const json&)>>;
 
 // One markdown table: a line per row of the report, the metrics [first, last), then `extra`.
-std::string table(const json& report, const json& per_row, std::vector<MetricInfo>::const_iterator first,
-                  std::vector<MetricInfo>::const_iterator last, const std::vector<Column>& extra) {
+std::string table(const json& report, const json& per_row, const std::vector<MetricInfo>& metrics,
+                  const std::vector<Column>& extra) {
   std::string head = "| configuration |", rule = "|---|";
-  for (auto k = first; k != last; ++k) {
-    head += fmt::format(" {} |", k->label);
+  for (const auto& k : metrics) {
+    head += fmt::format(" {} |", k.label);
     rule += "---|";
   }
   for (const auto& [label, value] : extra) {
@@ -286,11 +310,37 @@ std::string table(const json& report, const json& per_row, std::vector<MetricInf
     const std::string r = row["name"].get<std::string>();
     const json& s = per_row[r];
     md.append("| ").append(r).append(" |");
-    for (auto k = first; k != last; ++k) md.append(" ").append(cell(s, *k)).append(" |");
+    for (const auto& k : metrics) md.append(" ").append(cell(s, k)).append(" |");
     for (const auto& [label, value] : extra) md.append(" ").append(value(s)).append(" |");
     md.append("\n");
   }
   return md;
+}
+
+// The published figures of a sequence, under the measured ones (published_comparison's json).
+std::string published_table(const json& p, const json& report) {
+  std::string md = "Published, on the whole sequence (" + std::to_string(p["frames_published"].get<long>()) + " frames)";
+  md += p["full_sequence"].get<bool>() ? ":\n\n" : "; this dataset is an excerpt, so no row is compared with them:\n\n";
+  md += "| published | mode | ATE m | KITTI t_rel % | KITTI r_rel deg/100 m | RPE trans m | RPE rot rad | source | beaten by |\n"
+        "|---|---|---|---|---|---|---|---|---|\n";
+  const auto& sources = report.contains("published_sources") ? report["published_sources"] : json::object();
+  for (const auto& r : p["rows"]) {
+    std::string line = "| " + r["system"].get<std::string>() + " (published) | " + r["mode"].get<std::string>() + " |";
+    for (const char* k : {"ate_m", "kitti_t_rel_percent", "kitti_r_rel_deg_per_100m", "rpe_trans_m", "rpe_rot_rad"}) {
+      const json& v = r["values"].contains(k) ? r["values"][k] : json();
+      line += v.is_number() ? fmt::format(" {:g} |", v.get<double>()) : v.is_null() && r["values"].contains(k) ? " lost |" : " – |";
+    }
+    const std::string src = r["source"].get<std::string>();
+    std::string cite = sources.contains(src) ? sources[src].value("short", src) : src;
+    for (const auto& t : r["tables"]) cite.append(", ").append(t.get<std::string>());
+    if (!r["verified"].get<bool>()) cite += " (not checked against the paper's text)";
+    line += " " + cite + " |";
+    std::string by;
+    for (const auto& b : r["beaten_by"]) by.append(by.empty() ? "**" : ", **").append(b.get<std::string>()).append("**");
+    line += " " + (by.empty() ? std::string("–") : by) + " |\n";
+    md += line;
+  }
+  return md + "\n";
 }
 
 }  // namespace
@@ -307,6 +357,20 @@ std::string format_report_markdown(const json& report) {
                         : std::string());
   md += "Cells: median (min–max) over the runs. ATE: SE(3)-aligned RMSE of the translation; RPE with evo's "
         "definitions (consecutive pairs 1 frame or 1 m of path apart). Ratios are of medians.\n\n";
+  if (report.contains("timing") && report["timing"].is_object() && !report["timing"].value("comparable", true)) {
+    md += "**Timings are not comparable**: the runs came from " + report["timing"]["hosts"].dump() +
+          " (tracking ms, their ratios and Table I mix machines).\n\n";
+  }
+  if (report.contains("missing_runs") && !report["missing_runs"].empty()) {
+    md += fmt::format("**{} planned runs are missing**:", report["missing_runs"].size());
+    for (const auto& m : report["missing_runs"]) md.append(" `").append(m.get<std::string>()).append("`");
+    md += "\n\n";
+  }
+  if (report.contains("missing_sequences") && !report["missing_sequences"].empty()) {
+    md += "Standard sequences not found under the roots given:\n\n";
+    for (const auto& m : report["missing_sequences"]) md.append("- ").append(m.get<std::string>()).append("\n");
+    md += "\n";
+  }
   md += "Configurations:\n\n";
   for (const auto& c : report["configurations"]) {
     md += fmt::format("- `{}`: {}\n", c["name"].get<std::string>(), c["description"].get<std::string>());
@@ -317,14 +381,27 @@ std::string format_report_markdown(const json& report) {
     md += fmt::format("## {}\n\n`{}`, {} frames{}\n\n", name, d["path"].get<std::string>(), d.value("frames", 0),
                       d["gt_length_m"].is_number() ? fmt::format(", ground truth {:.2f} m", d["gt_length_m"].get<double>())
                                                    : std::string());
+    if (d.contains("convention") && d["convention"].is_string()) {
+      md += "Evaluation: " + d["convention"].get<std::string>() + ".\n\n";
+    }
     const json& per_row = report["summary"][name];
     const auto& metrics = bench_metrics();
-    // Accuracy (the first 5 metrics), then the system's behaviour and cost.
-    md += table(report, per_row, metrics.begin(), metrics.begin() + 5,
+    // Accuracy (the KITTI devkit's columns on KITTI input only), then the system's behaviour and cost.
+    std::vector<MetricInfo> accuracy;
+    for (std::size_t k = 0; k < kAccuracyMetrics; ++k) {
+      if (std::string_view(metrics[k].key).substr(0, 6) != "kitti_" || d.value("format", std::string()) == "kitti") {
+        accuracy.push_back(metrics[k]);
+      }
+    }
+    md += table(report, per_row, accuracy,
                 {{"ATE / full", [](const json& s) { return ratio_cell(s, "ratio_to_full", "ate_m"); }},
                  {"ATE / anchor", [](const json& s) { return ratio_cell(s, "ratio_to_anchor", "ate_m"); }}});
     md += "\n";
-    md += table(report, per_row, metrics.begin() + 5, metrics.end(),
+    if (d.contains("published") && d["published"].is_object()) md += published_table(d["published"], report);
+    if (report.contains("timing") && report["timing"].is_object() && !report["timing"].value("comparable", true)) {
+      md += "Timing (track ms and its ratios) not comparable: these runs came from several hosts.\n\n";
+    }
+    md += table(report, per_row, {metrics.begin() + kAccuracyMetrics, metrics.end()},
                 {{"ms / full", [](const json& s) { return ratio_cell(s, "ratio_to_full", "tracking_ms_median"); }},
                  {"ms / anchor", [](const json& s) { return ratio_cell(s, "ratio_to_anchor", "tracking_ms_median"); }},
                  {"failed runs", [](const json& s) {

@@ -28,6 +28,8 @@ struct BenchRow {
 struct BenchDataset {
   std::string name;  // unique, used as a folder name
   std::filesystem::path path;
+  std::filesystem::path calibration;  // `plslam run --calib`, where the folder has no sensor.yaml (TUM-VI)
+  std::string sequence_id;            // a standard sequence (euroc/MH01, kitti/06): its published figures
 };
 
 struct BenchJob {
@@ -51,9 +53,13 @@ std::vector<BenchDataset> name_datasets(const std::vector<std::filesystem::path>
 // The folder of one run: OUT/runs/<dataset>/<row>/run-<n>.
 std::filesystem::path run_folder(const std::filesystem::path& out, const BenchDataset& d, const BenchRow& r, int run);
 
+// A JSON file (stats.json, plan.json); InputError naming it when it is missing or not JSON.
+nlohmann::json read_json_file(const std::filesystem::path& p);
+
 // Scores one finished run folder (trajectory.tum, stats.json; frames.csv or frame_times_ms.txt)
 // against the dataset's ground truth: ate_m, rpe_frame_trans_m, rpe_frame_rot_deg, rpe_1m_trans_m,
-// rpe_1m_rot_deg, tracked_share, imu_share (plslam: frames tracked with the IMU), lost_events, relocalizations, loops, keyframes, map_points,
+// rpe_1m_rot_deg, kitti_t_rel_percent and kitti_r_rel_deg_per_100m (KITTI input: the devkit's metric
+// on trajectory.kitti, one pose per input frame), tracked_share, imu_share (plslam: frames tracked with the IMU), lost_events, relocalizations, loops, keyframes, map_points,
 // map_lines, tracking_ms_median, tracking_ms_p90. A value the run does not provide is null;
 // "error" says why a run has no score.
 nlohmann::json measure_run(const io::Dataset& dataset, const std::filesystem::path& folder, bool anchor);
@@ -72,6 +78,9 @@ const std::vector<MetricInfo>& bench_metrics();
 // stereo-inertial row when a stereo row exists.
 nlohmann::json summarize_runs(const nlohmann::json& results, const std::vector<BenchDataset>& datasets,
                               const std::vector<BenchRow>& rows);
+
+// The first metrics, up to kitti_r_rel_deg_per_100m, are accuracy; the rest behaviour and cost.
+constexpr std::size_t kAccuracyMetrics = 7;
 
 // report.md from report.json.
 std::string format_report_markdown(const nlohmann::json& report);

@@ -176,8 +176,11 @@ class EurocDataset final : public Dataset {
     if (pairs_.empty()) throw InputError(root_.string(), "no left/right images with matching timestamps");
   }
 
+  // EuRoC's state_groundtruth_estimate0, else TUM-VI's mocap0 (the same first 8 columns: the IMU's
+  // pose), which covers only part of the sequences outside the rooms.
   void load_ground_truth() {
-    const auto path = root_ / "state_groundtruth_estimate0" / "data.csv";
+    auto path = root_ / "state_groundtruth_estimate0" / "data.csv";
+    if (!fs::exists(path)) path = root_ / "mocap0" / "data.csv";
     if (!fs::exists(path)) return;
     const auto left = body_to_sensor(read_trajectory(path, TrajectoryFormat::kEuroc), cam0_.T_BS);
     // Keep the samples that overlap the selected frames (half a frame of slack at both ends).
