@@ -7,6 +7,7 @@
 #include "plslam/bench/slam_figures.h"
 #include "plslam/core/error.h"
 #include "plslam/eval/evaluate.h"
+#include "plslam/eval/kitti_metric.h"
 #include "plslam/io/trajectory_io.h"
 #include "support/test_support.h"
 
@@ -18,12 +19,15 @@ using nlohmann::json;
 // A dataset that only has a ground truth (the scoring reads nothing else).
 class GroundTruthOnly : public io::Dataset {
  public:
-  explicit GroundTruthOnly(Trajectory gt) {
+  explicit GroundTruthOnly(Trajectory gt, io::DatasetFormat format = io::DatasetFormat::kEuroc) : format_(format) {
     for (const auto& p : gt) timestamps_.push_back(p.t);
     gt_ = std::move(gt);
   }
-  io::DatasetFormat format() const override { return io::DatasetFormat::kEuroc; }
+  io::DatasetFormat format() const override { return format_; }
   io::StereoFrame load(std::size_t) const override { throw InputError("", "no images"); }
+
+ private:
+  io::DatasetFormat format_;
 };
 
 // A 5 m wavy path along x, 100 poses at 20 Hz, turning slowly.
@@ -174,6 +178,34 @@ TEST(SlamBenchScoring, ARunIsScoredLikePlslamEvalAndItsStatsAreRead) {
   EXPECT_EQ(m["map_lines"], 400);
   EXPECT_DOUBLE_EQ(m["tracking_ms_median"].get<double>(), 21.5);
   EXPECT_FALSE(m.contains("error"));
+}
+
+// KITTI input: the devkit's t_rel and r_rel, on trajectory.kitti (one pose per input frame), as
+// eval::kitti_odometry_metric gives them; none on EuRoC input or without the file.
+TEST(SlamBenchScoring, KittiInputIsScoredWithTheDevkitsMetricOnTrajectoryKitti) {
+  test::TempDir dir;
+  Trajectory gt;  // 300 m straight at 10 Hz, 1 m a frame
+  for (int i = 0; i <= 300; ++i) {
+    StampedPose p;
+    p.t = 0.1 * i;
+    p.T.translation() = Eigen::Vector3d(0, 0, i);
+    gt.push_back(p);
+  }
+  Trajectory est = gt;  // 1 % too long
+  for (auto& p : est) p.T.translation() *= 1.01;
+  const auto run = dir.path() / "run";
+  io::write_trajectory(run / "trajectory.tum", est, io::TrajectoryFormat::kTum);
+  io::write_trajectory(run / "trajectory.kitti", est, io::TrajectoryFormat::kKitti);
+  write_text(run / "stats.json", R"({"input_frames": 301, "tracked_frames": 301})");
+  const json m = measure_run(GroundTruthOnly(gt, io::DatasetFormat::kKitti), run, false);
+  const auto expected = eval::kitti_odometry_metric(gt, est);
+  ASSERT_TRUE(m["kitti_t_rel_percent"].is_number()) << m.dump();
+  EXPECT_DOUBLE_EQ(m["kitti_t_rel_percent"].get<double>(), expected.t_rel_percent);
+  EXPECT_NEAR(m["kitti_t_rel_percent"].get<double>(), 1.0, 0.02);  // the devkit divides by the nominal length
+  EXPECT_NEAR(m["kitti_r_rel_deg_per_100m"].get<double>(), 0.0, 1e-9);
+  EXPECT_TRUE(measure_run(GroundTruthOnly(gt), run, false)["kitti_t_rel_percent"].is_null());
+  fs::remove(run / "trajectory.kitti");
+  EXPECT_TRUE(measure_run(GroundTruthOnly(gt, io::DatasetFormat::kKitti), run, false)["kitti_t_rel_percent"].is_null());
 }
 
 TEST(SlamBenchScoring, AnAnchorsStatsAreReadFromItsOwnKeys) {
