@@ -1,7 +1,5 @@
 #include "plslam/bench/dataset_suites.h"
 
-#include <regex>
-
 #include <fmt/format.h>
 
 #include "plslam/core/error.h"
@@ -147,9 +145,12 @@ std::string standard_sequence_id(const fs::path& dataset) {
   if (p.filename().empty()) p = p.parent_path();
   if (p.filename() == "mav0") p = p.parent_path();
   const std::string name = p.filename().string();
-  static const std::regex tumvi(R"(dataset-room([1-6])_(512|1024)_16)");
-  std::smatch m;
-  if (std::regex_match(name, m, tumvi)) return "tumvi/room" + m[1].str();
+  // TUM-VI: dataset-room<1-6>_512_16 or _1024_16.
+  for (int k = 1; k <= 6; ++k) {
+    for (const char* px : {"512", "1024"}) {
+      if (name == fmt::format("dataset-room{}_{}_16", k, px)) return fmt::format("tumvi/room{}", k);
+    }
+  }
   for (const auto& s : standard_sequences()) {
     if (s.suite == Suite::kEuroc && name == s.folder) return s.id;
     if (s.suite == Suite::kKitti && name == s.folder && p.parent_path().filename() == "sequences") return s.id;
