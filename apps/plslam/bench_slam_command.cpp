@@ -620,8 +620,10 @@ int run_bench_slam(const BenchSlamArgs& a) {
     const auto t0 = std::chrono::steady_clock::now();
     const int rc = run_process(job_argv(row, d, folder, out, m.anchor, m.run_flag), log, [] { return app::stop_requested(); });
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (app::stop_requested()) break;  // cut off: no exit file, so --resume runs it again
-    bench::write_run_exit(folder, {rc, host});
+    // A run cut off by a signal still wrote its outputs so far: the report shows it (failed), but
+    // it leaves no exit file, so --resume runs it again.
+    const bool cut_off = app::stop_requested();
+    if (!cut_off) bench::write_run_exit(folder, {rc, host});
     json metrics = bench::measure_run(*opened[job.dataset], folder, row.anchor);
     if (rc != 0) ++failed;
     results.push_back(result_entry(d, row, job.run, rc, folder, out, wall, metrics));
