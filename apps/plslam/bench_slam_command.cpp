@@ -236,20 +236,17 @@ bench::BenchMatrix build_matrix(const BenchSlamArgs& a, const fs::path& out) {
   std::vector<fs::path> paths;
   std::vector<std::string> names, ids;
   std::vector<fs::path> calibs;
-  for (const auto& r : preset_renders(a.preset)) {
-    auto p = render(out, r);
-    if (app::stop_requested()) return m;
-    paths.push_back(p);
-    names.push_back(r.name);
-    ids.emplace_back();
-    calibs.emplace_back();
-  }
   auto add = [&](const fs::path& p, const std::string& name, const std::string& id, const fs::path& calib) {
     paths.push_back(p);
     names.push_back(name);
     ids.push_back(id);
     calibs.push_back(calib);
   };
+  for (const auto& r : preset_renders(a.preset)) {
+    auto p = render(out, r);
+    if (app::stop_requested()) return m;
+    add(p, r.name, "", {});
+  }
   if (a.preset == "paper") {
     for (auto& p : paper_real_sequences(a.shared)) add(p, "", bench::standard_sequence_id(p), {});
   }
@@ -317,8 +314,15 @@ json result_entry(const bench::BenchDataset& d, const bench::BenchRow& row, int 
           {"log", rel(bench::run_log_file(folder))}, {"wall_s", wall}, {"metrics", metrics}};
 }
 
+// Exit code and message for runs that failed (the report marks them and names their logs).
+int runs_failed(long failed, std::size_t runs) {
+  std::cerr << fmt::format("plslam: error: {} of {} runs failed; report.md marks them and names their logs\n", failed,
+                           runs);
+  return kExitRunsFailed;
+}
+
 // Writes report.json and report.md (and the figures) into `out`; prints the summary or the JSON.
-json write_report(const BenchSlamArgs& a, const bench::BenchMatrix& m, const std::vector<std::unique_ptr<io::Dataset>>& opened,
+void write_report(const BenchSlamArgs& a, const bench::BenchMatrix& m, const std::vector<std::unique_ptr<io::Dataset>>& opened,
                   const json& results, const json& table1, const json& extra, const fs::path& out,
                   std::chrono::steady_clock::time_point start) {
   json report;
@@ -435,7 +439,6 @@ json write_report(const BenchSlamArgs& a, const bench::BenchMatrix& m, const std
     }
     std::cout << fmt::format("report: {}\n", (out / "report.md").string());
   }
-  return report;
 }
 
 // --plan: the matrix's commands into FILE (the runs --resume finds complete left out), and
@@ -554,9 +557,7 @@ int report_from(const BenchSlamArgs& a, const fs::path& out, std::chrono::steady
     return kExitRunsFailed;
   }
   if (failed > 0) {
-    std::cerr << fmt::format("plslam: error: {} of {} runs failed; report.md marks them and names their logs\n", failed,
-                             results.size());
-    return kExitRunsFailed;
+    return runs_failed(failed, results.size());
   }
   return 0;
 }
@@ -657,9 +658,7 @@ int run_bench_slam(const BenchSlamArgs& a) {
     return app::stop_exit_code();
   }
   if (failed > 0) {
-    std::cerr << fmt::format("plslam: error: {} of {} runs failed; report.md marks them and names their logs\n", failed,
-                             results.size());
-    return kExitRunsFailed;
+    return runs_failed(failed, results.size());
   }
   return 0;
 }

@@ -7,15 +7,6 @@
 namespace plslam::bench {
 namespace fs = std::filesystem;
 
-const char* suite_name(Suite s) {
-  switch (s) {
-    case Suite::kEuroc: return "EuRoC";
-    case Suite::kKitti: return "KITTI";
-    case Suite::kTumvi: return "TUM-VI";
-  }
-  return "?";
-}
-
 const char* suite_convention(Suite s) {
   switch (s) {
     case Suite::kEuroc:

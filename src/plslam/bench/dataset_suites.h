@@ -13,7 +13,6 @@ enum class Suite { kEuroc, kKitti, kTumvi };
 
 // The evaluation convention of each benchmark, as the report states it.
 const char* suite_convention(Suite s);
-const char* suite_name(Suite s);
 
 struct SuiteSequence {
   Suite suite = Suite::kEuroc;

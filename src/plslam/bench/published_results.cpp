@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
 #include "plslam/core/error.h"
+#include "plslam/system/system_config.h"
 
 namespace plslam::bench {
 namespace fs = std::filesystem;
@@ -177,19 +177,7 @@ nlohmann::json published_comparison(const PublishedResults& published, const std
 }
 
 fs::path default_published_results_file() {
-  // As the vocabulary (system/system_config.cpp): the source tree's data/, PLSLAM_DATA_DIR, beside
-  // the program (<prefix>/bin/../share/plslam), the configured prefix.
-  const fs::path name = fs::path("published") / "slam_results.yaml";
-  if (const char* dir = std::getenv("PLSLAM_DATA_DIR"); dir && *dir) return fs::path(dir) / name;
-  std::vector<fs::path> candidates = {fs::path(PLSLAM_DEFAULT_VOCABULARY).parent_path().parent_path() / name};
-  std::error_code ec;
-  const auto exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) candidates.push_back(exe.parent_path().parent_path() / "share/plslam" / name);
-  candidates.push_back(fs::path(PLSLAM_INSTALL_DATA_DIR) / name);
-  for (const auto& c : candidates) {
-    if (fs::is_regular_file(c, ec)) return c;
-  }
-  return candidates.back();
+  return system::shipped_data_file(fs::path("published") / "slam_results.yaml");
 }
 
 }  // namespace plslam::bench

@@ -357,7 +357,9 @@ std::string format_report_markdown(const json& report) {
                         : std::string());
   md += "Cells: median (min–max) over the runs. ATE: SE(3)-aligned RMSE of the translation; RPE with evo's "
         "definitions (consecutive pairs 1 frame or 1 m of path apart). Ratios are of medians.\n\n";
-  if (report.contains("timing") && report["timing"].is_object() && !report["timing"].value("comparable", true)) {
+  const bool mixed_hosts =
+      report.contains("timing") && report["timing"].is_object() && !report["timing"].value("comparable", true);
+  if (mixed_hosts) {
     md += "**Timings are not comparable**: the runs came from " + report["timing"]["hosts"].dump() +
           " (tracking ms, their ratios and Table I mix machines).\n\n";
   }
@@ -398,7 +400,7 @@ std::string format_report_markdown(const json& report) {
                  {"ATE / anchor", [](const json& s) { return ratio_cell(s, "ratio_to_anchor", "ate_m"); }}});
     md += "\n";
     if (d.contains("published") && d["published"].is_object()) md += published_table(d["published"], report);
-    if (report.contains("timing") && report["timing"].is_object() && !report["timing"].value("comparable", true)) {
+    if (mixed_hosts) {
       md += "Timing (track ms and its ratios) not comparable: these runs came from several hosts.\n\n";
     }
     md += table(report, per_row, {metrics.begin() + kAccuracyMetrics, metrics.end()},

@@ -65,27 +65,28 @@ std::vector<std::pair<std::string, std::string>> config_values(const SystemOptio
   return out;
 }
 
-std::filesystem::path default_vocabulary_path() {
-  // The source tree's copy (a build tree), then the installed one: beside the running program
-  // (<prefix>/bin/../share/plslam, wherever the prefix was moved) or at the configured prefix (a
-  // program that embeds the library and lives elsewhere).
-  const std::filesystem::path source = PLSLAM_DEFAULT_VOCABULARY;
-  const auto name = source.filename();
+std::filesystem::path shipped_data_file(const std::filesystem::path& relative) {
   // PLSLAM_DATA_DIR (<prefix>/share/plslam) names an installed copy explicitly, for a prefix moved
   // after the build.
-  if (const char* dir = std::getenv("PLSLAM_DATA_DIR"); dir && *dir) {
-    return std::filesystem::path(dir) / "vocabulary" / name;
-  }
-  std::vector<std::filesystem::path> candidates = {source};
+  if (const char* dir = std::getenv("PLSLAM_DATA_DIR"); dir && *dir) return std::filesystem::path(dir) / relative;
+  // The source tree's data/ (PLSLAM_DEFAULT_VOCABULARY is data/vocabulary/<file>), then the
+  // installed copy: beside the running program (<prefix>/bin/../share/plslam, wherever the prefix
+  // was moved) or at the configured prefix (a program that embeds the library and lives elsewhere).
+  const std::filesystem::path source_data = std::filesystem::path(PLSLAM_DEFAULT_VOCABULARY).parent_path().parent_path();
+  std::vector<std::filesystem::path> candidates = {source_data / relative};
   std::error_code ec;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) candidates.push_back(exe.parent_path().parent_path() / "share/plslam/vocabulary" / name);
-  const std::filesystem::path installed = std::filesystem::path(PLSLAM_INSTALL_DATA_DIR) / "vocabulary" / name;
+  if (!ec) candidates.push_back(exe.parent_path().parent_path() / "share/plslam" / relative);
+  const std::filesystem::path installed = std::filesystem::path(PLSLAM_INSTALL_DATA_DIR) / relative;
   candidates.push_back(installed);
   for (const auto& c : candidates) {
     if (std::filesystem::is_regular_file(c, ec)) return c;
   }
   return installed;  // missing: loading it names this path
+}
+
+std::filesystem::path default_vocabulary_path() {
+  return shipped_data_file(std::filesystem::path("vocabulary") / std::filesystem::path(PLSLAM_DEFAULT_VOCABULARY).filename());
 }
 
 std::shared_ptr<const place::Vocabulary> load_vocabulary(const SystemOptions& o) {

@@ -34,6 +34,11 @@ std::vector<ConfigKeyInfo> config_keys();
 // Each key's value in `options`, as YAML text, in config_keys() order: (key, value).
 std::vector<std::pair<std::string, std::string>> config_values(const SystemOptions& options);
 
+// A file plslam ships under data/ (installed to <prefix>/share/plslam), by its path below it
+// ("vocabulary/...", "published/..."): $PLSLAM_DATA_DIR's when set, else the source tree's copy (a
+// build tree), else the installed one beside the running program or at the configured prefix; the
+// configured prefix's path when none exists (loading it names that path).
+std::filesystem::path shipped_data_file(const std::filesystem::path& relative);
 // The vocabulary plslam ships (data/vocabulary/, see README: place recognition).
 std::filesystem::path default_vocabulary_path();
 // The vocabulary the options ask for (null with place recognition off); InputError naming the
