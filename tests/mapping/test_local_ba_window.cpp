@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 
+#include "plslam/core/imu.h"
 #include "plslam/mapping/local_ba_window.h"
 #include "support/synthetic_views.h"
 
@@ -188,6 +189,39 @@ TEST(LocalBaWindow, AnAbortRaisedBeforeTheFirstIterationWritesBackTheStartAndSay
 TEST(LocalBaWindow, NothingToOptimiseWithoutObservations) {
   Chain c;  // keyframes without map points
   EXPECT_FALSE(run_local_ba(c.m.map, *c.kf[3], LocalBaOptions{}));
+}
+
+// A keyframe mapped after a black-out shares no landmark with the keyframe before it in time: once
+// the IMU chain of the window no longer reaches back to it, its IMU factor still ties it (with the
+// keyframe before it fixed) to the map before the gap. One that shares landmarks needs no such tie.
+TEST(LocalBaWindow, AKeyframeTiedToTheOneBeforeItByTheImuAloneKeepsThatFactor) {
+  for (const bool seen_across_the_gap : {false, true}) {
+    SCOPED_TRACE(seen_across_the_gap ? "2 sees A too" : "the black-out between 1 and 2");
+    Chain c;
+    c.m.observe_points(c.kf[0], c.A);
+    c.m.observe_points(c.kf[1], c.A);
+    c.m.observe_points(c.kf[2], seen_across_the_gap ? Chain::join({c.A, c.B}) : c.B);
+    c.m.observe_points(c.kf[3], Chain::join({c.B, c.C}));
+    c.m.observe_points(c.kf[4], c.C);
+    // At rest for 1 s, each keyframe 0.2 s after the one before it.
+    std::vector<ImuSample> samples;
+    for (int i = 0; i <= 200; ++i) samples.push_back({0.005 * i, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 9.81)});
+    c.kf[0]->set_imu({});
+    for (int k = 1; k < 5; ++k) {
+      auto pim = std::make_shared<const inertial::Preintegration>(samples, 0.2 * (k - 1), 0.2 * k, inertial::ImuBias{},
+                                                                  kEurocAdis16448Noise);
+      c.kf[k]->set_imu({Eigen::Vector3d::Zero(), {}, c.kf[k - 1], pim});
+    }
+    LocalBaOptions o;
+    o.imu_window = 1;  // the chain is 3 alone: its factor from 2
+    const MapBaProblem w = local_ba_window(*c.kf[3], o);
+    // 3 and its covisibles 2 and 4 are free; 1 is fixed: the IMU's tie to 2, or an observer of A.
+    std::map<map::KeyFrame*, bool> expected{{c.kf[1], true}, {c.kf[2], false}, {c.kf[3], false}, {c.kf[4], false}};
+    if (seen_across_the_gap) expected[c.kf[0]] = true;  // sees A too
+    EXPECT_EQ(fixed_flags(w), expected);
+    // 2 -> 3, and 1 -> 2 where the IMU alone ties 2 to 1 (4 shares C with 3: no factor of its own).
+    EXPECT_EQ(w.problem.keyframe_factors.size(), seen_across_the_gap ? 1u : 2u);
+  }
 }
 
 }  // namespace local_ba_window_test

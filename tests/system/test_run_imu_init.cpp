@@ -240,9 +240,10 @@ TEST(RunImuBlackOut, ThreeSecondsOfBlackFramesAreCarriedByTheImuAndRejoinTheMap)
   // The global BA that refines the initialisation 5 s after it (imu.refine_after_s) ran, at the
   // first keyframe after the black-out; the one 15 s after it lies beyond the run's 12 s.
   EXPECT_EQ(stats["loop_closing"]["global_ba_inertial_refinements"], 1) << stats["loop_closing"].dump();
-  // With the IMU's poses of the black-out (measured: 0.0315 m; without the black-out 0.0069; the
-  // inertial frames 0.056 m rmse, 0.126 m at the black-out's end, after 3 s on the IMU alone).
-  EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.05);
+  // With the IMU's poses of the black-out, smoothed between the frames vision tracked on either
+  // side (measured: 0.0093 m; without the black-out 0.0069. Predicted forward only, as tracking
+  // had them: 0.0315 m, the inertial frames 0.126 m off at the black-out's end).
+  EXPECT_LT(stats["accuracy"]["ape_trans_m"]["rmse"].get<double>(), 0.015);
   // frames.csv: the black frames are the inertial ones; trajectory.tum holds every frame.
   const auto log = eval::read_frame_log(tmp.path() / "vi" / "frames.csv");
   const auto frame_column = std::find(log.header.begin(), log.header.end(), "frame") - log.header.begin();

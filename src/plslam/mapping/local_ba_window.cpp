@@ -42,7 +42,20 @@ MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o,
   MapBaProblem window(o.line_information, o.far_stereo_baselines, o.lines);
   for (auto* k : local) window.add_keyframe(k, k->is_origin());
   window.add_landmarks_of(local);
-  if (!chain.empty()) window.add_imu_factors(chain, o.T_imu_cam, o.reintegration, /*add_missing=*/true);
+  if (!chain.empty()) {
+    // A free keyframe that shares no landmark with the keyframe before it in time keeps its IMU
+    // factor to it even out of the chain: mapped from the IMU's pose after a black-out, it is
+    // tied to the map before the gap by that factor alone. Without it, once the chain had moved
+    // on, the part after the gap drifted as a free island (a drone's render: 42 mm in 4 s).
+    std::vector<map::KeyFrame*> linked = chain;
+    for (auto* k : local) {
+      const auto imu = k->has_imu() ? k->imu() : std::nullopt;
+      if (imu && imu->previous && k->weight(imu->previous) == 0 && std::find(chain.begin(), chain.end(), k) == chain.end()) {
+        linked.push_back(k);
+      }
+    }
+    window.add_imu_factors(linked, o.T_imu_cam, o.reintegration, /*add_missing=*/true);
+  }
   return window;
 }
 

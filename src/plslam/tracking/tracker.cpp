@@ -199,6 +199,11 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   }
   prior_.reset();
   if (state_ == TrackingState::kOk) prior_ = imu_prior(f.data->timestamp);
+  std::optional<FrameRecord> stretch_end_predicted;
+  if (prior_ && last_carried_) {
+    stretch_end_predicted = records_.back();
+    stretch_end_predicted->T_cr = prior_->T_cw * pose_of(records_.back()).inverse() * records_.back().T_cr;
+  }
   bool inertial = false;
   bool new_view = false;  // inertial, and a keyframe whose new points the next frame searches
 
@@ -346,7 +351,9 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   if (rec.trusted()) {
     last_tracked_record_ = records_.size() - 1;
     trusted_since_recovery_ = true;
+    if (stretch_end_predicted && !(inertial && !new_view)) stretch_ends_.push_back({records_.size() - 1, *stretch_end_predicted});
   }
+  last_carried_ = inertial && !new_view;
   result.state = state_;
   result.frame_state = fs;
   if (ok) result.pose_covariance = f.pose_covariance;
@@ -362,6 +369,7 @@ void Tracker::settle_states() {
       rec.state = FrameState::kTracked;
     }
   }
+  smooth_inertial_stretches();
 }
 
 bool Tracker::relocalize_and_track(Frame& f, TrackResult& result) {

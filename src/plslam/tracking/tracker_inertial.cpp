@@ -227,6 +227,27 @@ bool Tracker::map_new_view_from_imu(Frame& f, TrackResult& result) {
   return true;
 }
 
+void Tracker::smooth_inertial_stretches() {
+  for (const StretchEnd& end : stretch_ends_) {
+    std::size_t first = end.record;
+    while (first > 0 && records_[first - 1].state == FrameState::kInertial) --first;
+    if (first == 0 || first == end.record || !records_[first - 1].trusted()) continue;
+    const double t0 = records_[first - 1].timestamp, t1 = records_[end.record].timestamp;
+    const geometry::SE3 T_wc_end = pose_of(records_[end.record]).inverse();
+    const geometry::SE3 T_wc_predicted = pose_of(end.predicted).inverse();
+    const Eigen::Vector3d dc = T_wc_end.translation() - T_wc_predicted.translation();
+    const Eigen::Vector3d dphi = geometry::so3_log(T_wc_end.rotation() * T_wc_predicted.rotation().transpose());
+    for (std::size_t k = first; k < end.record; ++k) {
+      FrameRecord& rec = records_[k];
+      const double w = (rec.timestamp - t0) / (t1 - t0);
+      const geometry::SE3 T_wc = pose_of(rec).inverse();
+      const geometry::SE3 smoothed(geometry::so3_exp(w * dphi) * T_wc.rotation(), T_wc.translation() + w * dc);
+      rec.T_cr = smoothed.inverse() * T_wc * rec.T_cr;
+    }
+  }
+  stretch_ends_.clear();
+}
+
 bool Tracker::within_inertial_window(double t) const {
   return last_visual_t_ && t - *last_visual_t_ <= options_.imu.max_inertial_s;
 }
