@@ -4,12 +4,14 @@
 # --no-imu (loop closing on). Per run: the ATE (se3), frames tracked, lost events, relocalizations,
 # new map segments, frames tracked with the IMU and carried by it alone, and the ratio of the two
 # ATEs. With --blackout S, frames S..S+19 (1 s) of both cameras are replaced by black images in a
-# copy of each render (its ATE against the same run without the black-out is the issue's bar).
+# copy of each render, and the render without them is run with the IMU too: the line ends with
+# the black-out's stereo-inertial ATE over that run's ("black-out ratio", the issue's bar).
 #
 #   bench/stereo_inertial.sh [--plslam PATH] [--seeds "31 32 33"] [--motions "handheld drone walk"]
 #                            [--frames N] [--blackout S] OUT
 #
-# OUT/stereo_inertial.txt: one line per render. About 40 s per render and seed (two runs).
+# OUT/stereo_inertial.txt: one line per render. About 40 s per render and seed (two runs; three
+# with --blackout).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 plslam=build/plslam seeds="31 32 33" motions="handheld drone walk" frames=480 blackout=-1
@@ -37,7 +39,7 @@ s = json.load(open(sys.argv[1]))
 imu = (s.get("imu") or {}).get("slam") or {}
 ate = s.get("accuracy", {}).get("ape_trans_m", {}).get("rmse", float("nan"))
 count = lambda v: v["count"] if isinstance(v, dict) else len(v) if isinstance(v, list) else v
-print(f"{ate:.4f} tracked {s['tracked_frames']} lost {s['lost_events']} reloc {count(s['relocalizations'])} "
+print(f"{ate:.5f} tracked {s['tracked_frames']} lost {s['lost_events']} reloc {count(s['relocalizations'])} "
       f"segments {count(s['new_map_segments'])} imu {imu.get('imu_tracked_frames', 0)} inertial {imu.get('inertial_frames', 0)}")
 PY
 }
@@ -60,6 +62,13 @@ for motion in $motions; do
     vo=$(figures "$out/vo_${motion}_$seed")
     ratio=$(/usr/bin/python3 -c "import sys; a, b = float(sys.argv[1]), float(sys.argv[2]); print(f'{a / b:.2f}')" \
       "${vi%% *}" "${vo%% *}")
-    echo "$motion seed $seed | stereo-inertial $vi | stereo $vo | ratio $ratio" | tee -a "$table"
+    line="$motion seed $seed | stereo-inertial $vi | stereo $vo | ratio $ratio"
+    if [ "$blackout" -ge 0 ]; then
+      "$plslam" run "$seq" --out "$out/vi_clean_${motion}_$seed" --quiet > /dev/null 2>&1 || true
+      clean=$(figures "$out/vi_clean_${motion}_$seed")
+      line="$line | without the black-out ${clean%% *} | black-out ratio $(/usr/bin/python3 -c \
+        "import sys; a, b = float(sys.argv[1]), float(sys.argv[2]); print(f'{a / b:.2f}')" "${vi%% *}" "${clean%% *}")"
+    fi
+    echo "$line" | tee -a "$table"
   done
 done
