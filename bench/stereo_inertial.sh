@@ -43,6 +43,8 @@ print(f"{ate:.5f} tracked {s['tracked_frames']} lost {s['lost_events']} reloc {c
       f"segments {count(s['new_map_segments'])} imu {imu.get('imu_tracked_frames', 0)} inertial {imu.get('inertial_frames', 0)}")
 PY
 }
+# A B: A / B, two decimals (ATEs as figures prints them first).
+ratio() { /usr/bin/python3 -c "import sys; print(f'{float(sys.argv[1]) / float(sys.argv[2]):.2f}')" "$1" "$2"; }
 for motion in $motions; do
   for seed in $seeds; do
     seq="$out/office_${motion}_$seed"
@@ -60,14 +62,11 @@ for motion in $motions; do
     "$plslam" run "$input" --out "$out/vo_${motion}_$seed" --quiet --no-imu > /dev/null 2>&1 || true
     vi=$(figures "$out/vi_${motion}_$seed")
     vo=$(figures "$out/vo_${motion}_$seed")
-    ratio=$(/usr/bin/python3 -c "import sys; a, b = float(sys.argv[1]), float(sys.argv[2]); print(f'{a / b:.2f}')" \
-      "${vi%% *}" "${vo%% *}")
-    line="$motion seed $seed | stereo-inertial $vi | stereo $vo | ratio $ratio"
+    line="$motion seed $seed | stereo-inertial $vi | stereo $vo | ratio $(ratio "${vi%% *}" "${vo%% *}")"
     if [ "$blackout" -ge 0 ]; then
       "$plslam" run "$seq" --out "$out/vi_clean_${motion}_$seed" --quiet > /dev/null 2>&1 || true
       clean=$(figures "$out/vi_clean_${motion}_$seed")
-      line="$line | without the black-out ${clean%% *} | black-out ratio $(/usr/bin/python3 -c \
-        "import sys; a, b = float(sys.argv[1]), float(sys.argv[2]); print(f'{a / b:.2f}')" "${vi%% *}" "${clean%% *}")"
+      line="$line | without the black-out ${clean%% *} | black-out ratio $(ratio "${vi%% *}" "${clean%% *}")"
     fi
     echo "$line" | tee -a "$table"
   done

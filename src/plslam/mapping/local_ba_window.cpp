@@ -49,7 +49,7 @@ MapBaProblem local_ba_window(map::KeyFrame& kf, const LocalBaOptions& o,
     // on, the part after the gap drifted as a free island (a drone's render: 42 mm in 4 s).
     std::vector<map::KeyFrame*> linked = chain;
     for (auto* k : local) {
-      const auto imu = k->has_imu() ? k->imu() : std::nullopt;
+      const auto imu = k->imu();
       if (imu && imu->previous && k->weight(imu->previous) == 0 && std::find(chain.begin(), chain.end(), k) == chain.end()) {
         linked.push_back(k);
       }

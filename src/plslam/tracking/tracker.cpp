@@ -348,12 +348,13 @@ TrackResult Tracker::track(std::shared_ptr<const map::FrameData> data) {
   rec.tracked = ok;
   rec.state = fs;
   records_.push_back(rec);
+  const bool carried = inertial && !new_view;
   if (rec.trusted()) {
     last_tracked_record_ = records_.size() - 1;
     trusted_since_recovery_ = true;
-    if (stretch_end_predicted && !(inertial && !new_view)) stretch_ends_.push_back({records_.size() - 1, *stretch_end_predicted});
+    if (stretch_end_predicted && !carried) stretch_ends_.push_back({records_.size() - 1, *stretch_end_predicted});
   }
-  last_carried_ = inertial && !new_view;
+  last_carried_ = carried;
   result.state = state_;
   result.frame_state = fs;
   if (ok) result.pose_covariance = f.pose_covariance;
